@@ -1,0 +1,23 @@
+//! Bit-accurate reference model of the snapgen motion core, and the host-side planners.
+//!
+//! * [`format`]: the fixed-point format, the single source of truth for widths, `Ts` and units.
+//! * [`program`]: the segment program the fabric plays.
+//! * [`chain`]: the sequencer and the snap integrator chain, per tick and in closed form.
+//! * [`peaks`]: exact register peaks over a program.
+//! * [`planner`]: seed 000 (order 4), orders 3 and 2, seed 001 (duration-based), and the
+//!   quantizer that makes the endpoint exact.
+//!
+//! This crate does no I/O.
+
+pub mod chain;
+pub mod error;
+pub mod format;
+pub mod peaks;
+pub mod planner;
+pub mod program;
+
+pub use chain::{ChainState, Sequencer, TickSample, Trace};
+pub use error::{FormatError, PlanError, ProgramError};
+pub use format::{Format, PositionFix, Quantity, Widths, DEFAULT_FORMAT, FRAC_BITS};
+pub use planner::{plan, plan_from, Method, MoveRequest, PhaseTicks, Plan};
+pub use program::{Program, Segment, SnapTimeline};
