@@ -1,1 +1,134 @@
-fn main() {}
+//! `snapgen`: plans jerk- and snap-limited moves for the snapgen motion core, and writes traces
+//! and plots from the bit-accurate model.
+//!
+//! Exit codes: 0 success, 1 failure (I/O), 2 bad input (a usage error or a move that cannot be
+//! planned; the message says what to change).
+
+mod args;
+mod demo;
+mod plot;
+mod report;
+mod trace;
+
+use std::fs::File;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use snapgen_model::{plan, Plan, PlanError};
+
+use args::{ArgError, PlanArgs};
+use report::PlanReport;
+
+/// Plans jerk- and snap-limited point-to-point moves for an FPGA motion core.
+#[derive(Parser)]
+#[command(name = "snapgen", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Plan a move and print it (human-readable, or one JSON object with --json).
+    Plan {
+        #[command(flatten)]
+        plan: PlanArgs,
+        /// Print one JSON object instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Write the per-tick trace of a move from the bit-accurate model as CSV.
+    Trace {
+        #[command(flatten)]
+        plan: PlanArgs,
+        /// Output CSV file.
+        #[arg(long)]
+        csv: PathBuf,
+        /// Write every N-th tick only (the last tick is always written).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
+    },
+    /// Plot position, velocity, acceleration, jerk and snap of a move as SVG.
+    Plot {
+        #[command(flatten)]
+        plan: PlanArgs,
+        /// Output SVG file.
+        #[arg(long)]
+        svg: PathBuf,
+    },
+    /// The main job on built-in defaults: plan the seed 001 Table 1 and Table 3 moves and a
+    /// seed 000 move, print the plans, write their plots.
+    Demo {
+        /// Directory for the plots.
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+    },
+}
+
+/// Errors that are the user's to fix (exit 2).
+#[derive(Debug, thiserror::Error)]
+enum InputError {
+    #[error(transparent)]
+    Args(#[from] ArgError),
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
+
+fn make_plan(a: &PlanArgs) -> Result<Plan, InputError> {
+    let request = a.request()?;
+    Ok(plan(&request, &a.format())?)
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Plan { plan, json } => {
+            let p = make_plan(&plan)?;
+            let r = PlanReport::new(&p);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r)?);
+            } else {
+                print!("{}", r.human());
+            }
+        }
+        Command::Trace { plan, csv, every } => {
+            let p = make_plan(&plan)?;
+            let file =
+                File::create(&csv).with_context(|| format!("cannot create {}", csv.display()))?;
+            let rows = trace::write_csv(&p, every, file)
+                .with_context(|| format!("cannot write {}", csv.display()))?;
+            eprintln!("wrote {rows} rows to {}", csv.display());
+        }
+        Command::Plot { plan, svg } => {
+            let p = make_plan(&plan)?;
+            let title = format!(
+                "order {} move of {} units, {} ticks of {} s",
+                p.order(),
+                p.request.distance,
+                p.ticks_total(),
+                p.format.ts
+            );
+            plot::write_svg(&p, &title, &svg)
+                .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", svg.display()))?;
+            eprintln!("wrote {}", svg.display());
+        }
+        Command::Demo { out } => demo::run(&out)?,
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if e.downcast_ref::<InputError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}

@@ -115,7 +115,7 @@ pub enum PlanError {
         max: f64,
     },
     /// The target does not fit the position register.
-    #[error("distance {distance} is outside the format's position range ±{max}: shorten the move or use a coarser position LSB")]
+    #[error("distance {distance} is outside the format's position range ±{max:.6}: shorten the move or use a coarser position LSB")]
     DistanceOutOfRange {
         /// Requested distance.
         distance: f64,
@@ -123,7 +123,7 @@ pub enum PlanError {
         max: f64,
     },
     /// A limit below one raw LSB of its register.
-    #[error("{quantity} limit {limit} {unit} is below the format's resolution ({lsb:e} {unit} per LSB): raise the limit, lengthen Ts or use a finer position LSB")]
+    #[error("{quantity} limit {limit:e} {unit} is below the format's resolution ({lsb:e} {unit} per LSB): raise the limit, lengthen Ts or use a finer position LSB")]
     LimitBelowResolution {
         /// Quantity name.
         quantity: &'static str,

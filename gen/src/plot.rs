@@ -1,0 +1,101 @@
+//! `snapgen plot`: position, velocity, acceleration, jerk and snap against time, as SVG.
+//!
+//! Long moves are drawn from per-bucket minima and maxima of the integer trace, so one-tick
+//! snap impulses stay visible however many ticks share a pixel.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+use snapgen_model::{Plan, Quantity, Trace};
+
+/// Number of time buckets drawn.
+const BUCKETS: u64 = 1000;
+
+/// One bucket: time and (min, max) of x, v, a, j, d.
+struct Bucket {
+    t: f64,
+    lo: [f64; 5],
+    hi: [f64; 5],
+}
+
+fn buckets(plan: &Plan) -> Vec<Bucket> {
+    let f = plan.format;
+    let x0 = f.position_physical(plan.start.x);
+    let per = (plan.ticks_total() / BUCKETS).max(1);
+    let mut out: Vec<Bucket> = Vec::new();
+    for t in Trace::new(&plan.program, plan.start, f.widths) {
+        let s = t.state;
+        let vals = [
+            f.position_physical(s.x) - x0,
+            f.to_physical(Quantity::Velocity, s.v),
+            f.to_physical(Quantity::Acceleration, s.a),
+            f.to_physical(Quantity::Jerk, s.j),
+            f.to_physical(Quantity::Snap, t.d),
+        ];
+        let k = t.tick / per;
+        match out.last_mut() {
+            Some(b) if (b.t / f.ts) as u64 / per == k => {
+                for i in 0..5 {
+                    b.lo[i] = b.lo[i].min(vals[i]);
+                    b.hi[i] = b.hi[i].max(vals[i]);
+                }
+            }
+            _ => out.push(Bucket {
+                t: (k * per) as f64 * f.ts,
+                lo: vals,
+                hi: vals,
+            }),
+        }
+    }
+    out
+}
+
+/// Errors while drawing.
+pub type PlotError = Box<dyn std::error::Error + Send + Sync>;
+
+/// Draws the five panels into `path`.
+pub fn write_svg(plan: &Plan, title: &str, path: &Path) -> Result<(), PlotError> {
+    let data = buckets(plan);
+    let t_end = (plan.ticks_total() as f64 * plan.format.ts).max(plan.format.ts);
+    let root = SVGBackend::new(path, (1000, 1200)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (head, body) = root.split_vertically(40);
+    head.titled(title, ("sans-serif", 20))?;
+    let panels = body.split_evenly((5, 1));
+    let names = [
+        ("position", "units"),
+        ("velocity", "units/s"),
+        ("acceleration", "units/s^2"),
+        ("jerk", "units/s^3"),
+        ("snap", "units/s^4"),
+    ];
+    let colors = [&BLUE, &RED, &GREEN, &MAGENTA, &BLACK];
+    for (i, area) in panels.iter().enumerate() {
+        let lo = data.iter().map(|b| b.lo[i]).fold(f64::INFINITY, f64::min);
+        let hi = data
+            .iter()
+            .map(|b| b.hi[i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let pad = ((hi - lo) * 0.05).max(1e-12);
+        let mut chart = ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(90)
+            .caption(
+                format!("{} ({})", names[i].0, names[i].1),
+                ("sans-serif", 16),
+            )
+            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_label_formatter(&|y| format!("{y:.3e}"))
+            .draw()?;
+        // The envelope: lower and upper edge of every bucket.
+        let color = colors[i];
+        chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.hi[i])), color))?;
+        chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.lo[i])), color))?;
+    }
+    root.present()?;
+    Ok(())
+}

@@ -1,0 +1,259 @@
+//! Plan reports: one JSON object (`--json`) or a human-readable summary.
+//!
+//! Physical values are in user units and seconds; raw values are the integers the fabric holds.
+//! Snap values in `segments` exceed 2^53: read the JSON with a reader that keeps big integers
+//! (Python's `json` does).
+
+use serde::Serialize;
+use snapgen_model::{planner::DurationValues, Plan, Quantity, Segment, FRAC_BITS};
+
+/// Peak magnitudes over the move, from the integer trace.
+#[derive(Serialize)]
+pub struct PeakReport {
+    /// max |v| (units/s).
+    pub v: f64,
+    /// max |a| (units/s²).
+    pub a: f64,
+    /// max |j| (units/s³).
+    pub j: f64,
+    /// max |d| (units/s⁴).
+    pub d: f64,
+}
+
+/// State at the end of the move, from the integer trace.
+#[derive(Serialize)]
+pub struct FinalReport {
+    /// Output position reached (whole output LSBs × LSB, units, from the start): what the
+    /// fabric's position port shows. The sub-LSB remainder is `final_residual_lsb`.
+    pub x: f64,
+    /// Velocity (units/s).
+    pub v: f64,
+    /// Acceleration (units/s²).
+    pub a: f64,
+    /// Jerk (units/s³).
+    pub j: f64,
+}
+
+/// Phase times in ticks; only the order's phases are present.
+#[derive(Serialize, Default)]
+pub struct PhaseReport {
+    /// t_d (order 4).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub d: Option<u64>,
+    /// t_j (orders 4, 3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub j: Option<u64>,
+    /// t_a.
+    pub a: u64,
+    /// t_v (cruise).
+    pub v: u64,
+}
+
+/// The format the plan is for.
+#[derive(Serialize)]
+pub struct FormatReport {
+    /// Tick period (s).
+    pub ts: f64,
+    /// Output position LSB (units).
+    pub position_lsb: f64,
+    /// Fractional bits below the output LSB.
+    pub frac_bits: u32,
+    /// Register widths x, v, a, j, d.
+    pub widths: [u32; 5],
+}
+
+/// The `--json` object of `snapgen plan`.
+#[derive(Serialize)]
+pub struct PlanReport {
+    /// 4, 3 or 2.
+    pub order: u8,
+    /// "order4", "order3", "order2" or "duration".
+    pub method: &'static str,
+    /// Tick period (s).
+    pub ts: f64,
+    /// Ticks the program lasts.
+    pub ticks_total: u64,
+    /// Seconds the program lasts.
+    pub duration_s: f64,
+    /// Phase times in ticks: order 4 {d,j,a,v}; order 3 {j,a,v}; order 2 {a,v}.
+    pub phase_ticks: PhaseReport,
+    /// Cruise ticks added so the integer trace respects the limits.
+    pub cruise_extension_ticks: u64,
+    /// The program.
+    pub segments: Vec<Segment>,
+    /// Integer amplitude of the program (snap, jerk or acceleration raw, signed).
+    pub amplitude_raw: i128,
+    /// Amplitude after the continuous planner's last recomputation (physical, signed).
+    pub continuous_amplitude: f64,
+    /// Peaks from the integer trace.
+    pub peak: PeakReport,
+    /// Final state from the integer trace.
+    pub r#final: FinalReport,
+    /// Requested distance (units).
+    pub distance: f64,
+    /// Target: the distance rounded to whole output LSBs (units).
+    pub target: f64,
+    /// Target in output LSBs.
+    pub target_lsb: i128,
+    /// Final output position minus the requested distance (units); ≤ half an LSB.
+    pub final_position_error: f64,
+    /// Final output position minus the target, in output LSBs (0 for every plan).
+    pub final_error_lsb: i128,
+    /// Position register minus the target cell's centre, as a fraction of an output LSB.
+    pub final_residual_lsb: f64,
+    /// Physical size of one output LSB (units).
+    pub position_lsb: f64,
+    /// The fixed-point format.
+    pub format: FormatReport,
+    /// Seed 001: ω_d (units/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<f64>,
+    /// Seed 001: α_d (units/s²).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acceleration: Option<f64>,
+    /// Seed 001: J_d (units/s³).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jerk: Option<f64>,
+    /// Seed 001: T_acc (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub t_acc: Option<f64>,
+    /// Seed 001: T_jerk (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub t_jerk: Option<f64>,
+}
+
+impl PlanReport {
+    /// Builds the report of a plan.
+    pub fn new(p: &Plan) -> Self {
+        let f = &p.format;
+        let dv: Option<DurationValues> = p.duration_values;
+        let order = p.order();
+        let phase_ticks = PhaseReport {
+            d: (order == 4).then_some(p.phases.d),
+            j: (order >= 3).then_some(p.phases.j),
+            a: p.phases.a,
+            v: p.phases.v,
+        };
+        PlanReport {
+            order,
+            method: match p.request.method {
+                snapgen_model::Method::Order4 { .. } => "order4",
+                snapgen_model::Method::Order3 { .. } => "order3",
+                snapgen_model::Method::Order2 { .. } => "order2",
+                snapgen_model::Method::Duration { .. } => "duration",
+            },
+            ts: f.ts,
+            ticks_total: p.ticks_total(),
+            duration_s: p.duration_s(),
+            phase_ticks,
+            cruise_extension_ticks: p.cruise_extension,
+            segments: p.program.segments.clone(),
+            amplitude_raw: p.amplitude_raw,
+            continuous_amplitude: p.continuous_amplitude,
+            peak: PeakReport {
+                v: p.peak_physical(Quantity::Velocity),
+                a: p.peak_physical(Quantity::Acceleration),
+                j: p.peak_physical(Quantity::Jerk),
+                d: p.peak_physical(Quantity::Snap),
+            },
+            r#final: FinalReport {
+                x: (p.target_lsb + p.final_error_lsb()) as f64 * f.position_lsb,
+                v: p.final_physical(Quantity::Velocity),
+                a: p.final_physical(Quantity::Acceleration),
+                j: p.final_physical(Quantity::Jerk),
+            },
+            distance: p.request.distance,
+            target: p.target_physical(),
+            target_lsb: p.target_lsb,
+            final_position_error: p.final_position_error(),
+            final_error_lsb: p.final_error_lsb(),
+            final_residual_lsb: p.residual_raw() as f64 / (1u128 << FRAC_BITS) as f64,
+            position_lsb: f.position_lsb,
+            format: FormatReport {
+                ts: f.ts,
+                position_lsb: f.position_lsb,
+                frac_bits: FRAC_BITS,
+                widths: f.widths.as_array(),
+            },
+            velocity: dv.map(|d| d.velocity),
+            acceleration: dv.map(|d| d.acceleration),
+            jerk: dv.map(|d| d.jerk),
+            t_acc: dv.map(|d| d.t_acc),
+            t_jerk: dv.map(|d| d.t_jerk),
+        }
+    }
+
+    /// The human-readable summary.
+    pub fn human(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{} move of {} units (target {} = {} LSB of {}), Ts = {} s",
+            self.method, self.distance, self.target, self.target_lsb, self.position_lsb, self.ts
+        );
+        if let (Some(v), Some(a), Some(j), Some(ta), Some(tj)) = (
+            self.velocity,
+            self.acceleration,
+            self.jerk,
+            self.t_acc,
+            self.t_jerk,
+        ) {
+            let _ = writeln!(
+                s,
+                "  seed 001: velocity {v:.4} units/s, acceleration {a:.4} units/s^2, jerk {j:.4} units/s^3, T_acc {ta:.4} s, T_jerk {tj:.4} s"
+            );
+        }
+        let ph = &self.phase_ticks;
+        let phases: Vec<String> = [
+            ("d", ph.d),
+            ("j", ph.j),
+            ("a", Some(ph.a)),
+            ("v", Some(ph.v)),
+        ]
+        .iter()
+        .filter_map(|(k, v)| v.map(|v| format!("t_{k} = {v}")))
+        .collect();
+        let _ = writeln!(
+            s,
+            "  phases (ticks): {}{}",
+            phases.join(", "),
+            if self.cruise_extension_ticks > 0 {
+                format!(
+                    " (cruise lengthened by {} ticks to keep the integer trace within limits)",
+                    self.cruise_extension_ticks
+                )
+            } else {
+                String::new()
+            }
+        );
+        let _ = writeln!(
+            s,
+            "  duration: {} ticks = {:.6} s in {} segments",
+            self.ticks_total,
+            self.duration_s,
+            self.segments.len()
+        );
+        let _ = writeln!(
+            s,
+            "  peaks (integer trace): |v| {:.6} units/s, |a| {:.6} units/s^2, |j| {:.6} units/s^3, |d| {:.6} units/s^4",
+            self.peak.v, self.peak.a, self.peak.j, self.peak.d
+        );
+        let _ = writeln!(
+            s,
+            "  final: x {} units, v {}, a {}, j {}; output error {} LSB, residual {:.3e} LSB, vs request {:.3e} units",
+            self.r#final.x,
+            self.r#final.v,
+            self.r#final.a,
+            self.r#final.j,
+            self.final_error_lsb,
+            self.final_residual_lsb,
+            self.final_position_error
+        );
+        let _ = writeln!(s, "  program (ticks x raw snap):");
+        for (i, seg) in self.segments.iter().enumerate() {
+            let _ = writeln!(s, "    {i:>3}: {:>10} x {}", seg.ticks, seg.snap);
+        }
+        s
+    }
+}
