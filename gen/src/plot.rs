@@ -35,9 +35,9 @@ fn buckets(plan: &Plan) -> Vec<Bucket> {
         let k = t.tick / per;
         match out.last_mut() {
             Some(b) if (b.t / f.ts) as u64 / per == k => {
-                for i in 0..5 {
-                    b.lo[i] = b.lo[i].min(vals[i]);
-                    b.hi[i] = b.hi[i].max(vals[i]);
+                for (i, v) in vals.iter().enumerate() {
+                    b.lo[i] = b.lo[i].min(*v);
+                    b.hi[i] = b.hi[i].max(*v);
                 }
             }
             _ => out.push(Bucket {

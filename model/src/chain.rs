@@ -39,15 +39,42 @@ pub fn wrap(value: i128, bits: u32) -> i128 {
 }
 
 /// Binomial coefficient `C(n, k)` for `k ≤ 4` and `n < 2^32`, exact in `u128`.
+///
+/// Written without 128-bit division (a library call): the small factors are divided out of
+/// 64-bit partial products, which the compiler turns into multiplications.
 #[inline]
 pub fn binomial(n: u64, k: u32) -> u128 {
-    let n = u128::from(n);
+    debug_assert!(n < 1 << 32, "segment tick counts are 32-bit");
+    // C(n, 2) for n and n − 2, as u64 (no overflow for n < 2^32).
+    let c2 = |m: u64| m * m.saturating_sub(1) / 2;
     match k {
         0 => 1,
-        1 => n,
-        2 => n * n.saturating_sub(1) / 2,
-        3 => n * n.saturating_sub(1) * n.saturating_sub(2) / 6,
-        4 => n * n.saturating_sub(1) * n.saturating_sub(2) * n.saturating_sub(3) / 24,
+        1 => u128::from(n),
+        2 => u128::from(c2(n)),
+        3 => {
+            // C(n,3) = C(n,2)·(n−2)/3, and 3 divides one of n, n−1, n−2.
+            let (a, b) = (c2(n), n.saturating_sub(2));
+            if a % 3 == 0 {
+                u128::from(a / 3) * u128::from(b)
+            } else {
+                u128::from(a) * u128::from(b / 3)
+            }
+        }
+        4 => {
+            // C(n,4) = C(n,2)·C(n−2,2)/6; 3 divides one factor and 2 one factor.
+            let (mut a, mut b) = (c2(n), c2(n.saturating_sub(2)));
+            if a % 3 == 0 {
+                a /= 3;
+            } else {
+                b /= 3;
+            }
+            if a % 2 == 0 {
+                a /= 2;
+            } else {
+                b /= 2;
+            }
+            u128::from(a) * u128::from(b)
+        }
         _ => unreachable!("the chain has four integrators"),
     }
 }
@@ -121,6 +148,30 @@ impl ChainState {
                 w.x,
             ),
         }
+    }
+
+    /// `n` ticks of constant snap `d` in closed form without wrapping: `None` if any value or
+    /// intermediate product leaves `i128`.
+    #[inline]
+    pub fn checked_advance(&self, d: i128, n: u64) -> Option<Self> {
+        let c = |k| i128::try_from(binomial(n, k)).ok();
+        let (c1, c2, c3, c4) = (c(1)?, c(2)?, c(3)?, c(4)?);
+        let m = |a: i128, b: i128| a.checked_mul(b);
+        Some(ChainState {
+            j: self.j.checked_add(m(c1, d)?)?,
+            a: self.a.checked_add(m(c1, self.j)?)?.checked_add(m(c2, d)?)?,
+            v: self
+                .v
+                .checked_add(m(c1, self.a)?)?
+                .checked_add(m(c2, self.j)?)?
+                .checked_add(m(c3, d)?)?,
+            x: self
+                .x
+                .checked_add(m(c1, self.v)?)?
+                .checked_add(m(c2, self.a)?)?
+                .checked_add(m(c3, self.j)?)?
+                .checked_add(m(c4, d)?)?,
+        })
     }
 
     /// Runs a whole program segment by segment in closed form and returns the final state.
@@ -257,6 +308,20 @@ mod tests {
                 s = s.step(d, &w);
             }
             assert_eq!(start.advance(d, n, &w), s, "d={d} n={n}");
+        }
+    }
+
+    #[test]
+    fn binomials_are_exact() {
+        let reference = |n: u64, k: u32| -> u128 {
+            let n = u128::from(n);
+            (0..u128::from(k)).fold(1u128, |acc, i| acc * (n - i) / (i + 1))
+        };
+        for n in (0..200u64).chain([(1 << 32) - 1, (1 << 32) - 2, 3_000_000_007, 65_536]) {
+            for k in 0..=4 {
+                let want = if n < u64::from(k) { 0 } else { reference(n, k) };
+                assert_eq!(binomial(n, k), want, "C({n},{k})");
+            }
         }
     }
 

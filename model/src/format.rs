@@ -92,9 +92,10 @@ impl Default for Format {
 }
 
 /// The physical quantity a raw register value stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Quantity {
     /// Position (units).
+    #[default]
     Position,
     /// Velocity (units/s).
     Velocity,

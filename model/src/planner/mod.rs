@@ -23,7 +23,7 @@ use crate::format::{Format, Quantity, FRAC_BITS};
 use crate::peaks::{peaks, Peaks};
 use crate::program::Program;
 pub use duration::{DurationInput, DurationValues};
-use quantize::{div_ceil, div_round, unit_response, unit_ticks, Shape};
+use quantize::{div_ceil, unit_response, unit_ticks, Shape};
 
 /// Phase times in ticks. Order 4: `d` = t_d, `j` = t_j, `a` = t_a, `v` = t_v (seed 000);
 /// order 3: `j`, `a`, `v` (jerk, constant acceleration, cruise; `d` = 0); order 2: `a`, `v`.
@@ -120,30 +120,32 @@ impl Method {
     }
 
     /// The requested limits as `(quantity, flag name, value)`.
-    fn limits(&self) -> Vec<(Quantity, &'static str, f64)> {
+    fn limits(&self) -> Limits {
+        let mut l = Limits::default();
         match *self {
             Method::Order4 {
                 vmax,
                 amax,
                 jmax,
                 dmax,
-            } => vec![
-                (Quantity::Velocity, "vmax", vmax),
-                (Quantity::Acceleration, "amax", amax),
-                (Quantity::Jerk, "jmax", jmax),
-                (Quantity::Snap, "dmax", dmax),
-            ],
-            Method::Order3 { vmax, amax, jmax } => vec![
-                (Quantity::Velocity, "vmax", vmax),
-                (Quantity::Acceleration, "amax", amax),
-                (Quantity::Jerk, "jmax", jmax),
-            ],
-            Method::Order2 { vmax, amax } => vec![
-                (Quantity::Velocity, "vmax", vmax),
-                (Quantity::Acceleration, "amax", amax),
-            ],
-            Method::Duration { .. } => vec![],
+            } => {
+                l.push(Quantity::Velocity, "vmax", vmax);
+                l.push(Quantity::Acceleration, "amax", amax);
+                l.push(Quantity::Jerk, "jmax", jmax);
+                l.push(Quantity::Snap, "dmax", dmax);
+            }
+            Method::Order3 { vmax, amax, jmax } => {
+                l.push(Quantity::Velocity, "vmax", vmax);
+                l.push(Quantity::Acceleration, "amax", amax);
+                l.push(Quantity::Jerk, "jmax", jmax);
+            }
+            Method::Order2 { vmax, amax } => {
+                l.push(Quantity::Velocity, "vmax", vmax);
+                l.push(Quantity::Acceleration, "amax", amax);
+            }
+            Method::Duration { .. } => {}
         }
+        l
     }
 
     fn shape(&self) -> Shape {
@@ -152,6 +154,24 @@ impl Method {
             3 => Shape::Jerk3,
             _ => Shape::Accel2,
         }
+    }
+}
+
+/// Up to four requested limits, on the stack.
+#[derive(Clone, Copy, Default)]
+struct Limits {
+    items: [(Quantity, &'static str, f64); 4],
+    len: usize,
+}
+
+impl Limits {
+    fn push(&mut self, q: Quantity, name: &'static str, value: f64) {
+        self.items[self.len] = (q, name, value);
+        self.len += 1;
+    }
+
+    fn iter(&self) -> impl Iterator<Item = (Quantity, &'static str, f64)> + '_ {
+        self.items[..self.len].iter().copied()
     }
 }
 
@@ -315,7 +335,7 @@ pub fn validate(request: &MoveRequest, format: &Format) -> Result<(), PlanError>
             ratio("phi", phi)?;
         }
         m => {
-            for (_, name, value) in m.limits() {
+            for (_, name, value) in m.limits().iter() {
                 positive(name, value)?;
             }
         }
@@ -452,7 +472,7 @@ fn amp_q_power(q: Quantity) -> i32 {
 /// Raw limits `(quantity, flag, floor(limit · scale))`, `None` where the register is the bound.
 fn raw_limits(m: &Method, f: &Format) -> Result<Vec<(Quantity, Option<I256>)>, PlanError> {
     let mut out = Vec::new();
-    for (q, _, value) in m.limits() {
+    for (q, _, value) in m.limits().iter() {
         let raw = value * f.scale(q);
         if raw < 1.0 {
             return Err(PlanError::LimitBelowResolution {
@@ -509,22 +529,21 @@ fn quantize_into(
         if ticks > u128::from(max_ticks) {
             return Err(too_long(ticks));
         }
-        let unit = unit_response(shape, &phases);
-        let gain = unit.gain;
-        // Largest amplitude allowed by every limit and by every register's width.
-        let mut k_lim: Option<(I256, Quantity, bool)> = None;
-        let mut consider = |bound: I256, q: Quantity, is_limit: bool| {
-            let peak = unit_peak(&unit.peaks, q);
-            if peak > 0 {
-                let k = bound / peak;
-                if k_lim.is_none_or(|(best, _, _)| k < best) {
-                    k_lim = Some((k, q, is_limit));
-                }
-            }
+        let Some(unit) = unit_response(shape, &phases) else {
+            return Err(PlanError::GainTooLarge {
+                log2_gain: 127.0,
+                frac: FRAC_BITS,
+            });
         };
+        let gain = unit.gain;
+        // Largest amplitude allowed by every limit and by every register's width:
+        // min(floor(bound / unit_peak)).
+        let mut bounds: [(I256, Quantity, bool); 8] = [(I256::ZERO, Quantity::Snap, false); 8];
+        let mut n = 0;
         for (q, raw) in &limits {
             if let Some(raw) = raw {
-                consider(*raw, *q, true);
+                bounds[n] = (*raw, *q, true);
+                n += 1;
             }
         }
         for q in [
@@ -533,14 +552,29 @@ fn quantize_into(
             Quantity::Jerk,
             Quantity::Snap,
         ] {
-            consider(I256::from(Format::register_max(f.width(q))), q, false);
+            bounds[n] = (I256::from(Format::register_max(f.width(q))), q, false);
+            n += 1;
         }
+        // The tightest bound: compare bound/peak fractions by cross-multiplying (exact in
+        // 256 bits), then divide once.
+        let mut best: Option<(I256, I256, Quantity, bool)> = None;
+        for &(bound, q, is_limit) in &bounds[..n] {
+            let peak = unit_peak(&unit.peaks, q);
+            if peak <= 0 {
+                continue;
+            }
+            if best.is_none_or(|(b, p, _, _)| bound * p < b * peak) {
+                best = Some((bound, peak, q, is_limit));
+            }
+        }
+        // Both fit i128 (bounds ≤ 2^126, peaks come from i128).
+        let k_lim = best.map(|(b, p, q, l)| (I256::from(b.as_i128() / p.as_i128()), q, l));
         let (k_lim, bound_q, is_limit) = k_lim.expect("the unit program has a snap peak");
         if k_lim < 1 {
             return Err(if is_limit {
                 let (_, _, value) = m
                     .limits()
-                    .into_iter()
+                    .iter()
                     .find(|(q, _, _)| *q == bound_q)
                     .expect("bound came from a limit");
                 PlanError::LimitBelowResolution {
@@ -563,7 +597,9 @@ fn quantize_into(
                 frac: FRAC_BITS,
             });
         }
-        let k = div_round(x_abs, gain);
+        // X < 2^112 and P < 2^80: round(X / P) in i128.
+        let (x128, p128) = (x_abs.as_i128(), gain.as_i128());
+        let k = I256::from((2 * x128 + p128) / (2 * p128));
         if k > k_lim {
             // Lengthen the cruise so that K_lim · P' ≥ X: each tick adds the cruise velocity.
             let cruise_v = unit.peaks.v;
@@ -576,26 +612,23 @@ fn quantize_into(
         }
         let k = i128::try_from(k).expect("k ≤ k_lim ≤ register max");
         let amp = sign * k;
-        let program = crate::program::Program {
-            segments: unit
-                .program
-                .segments
-                .iter()
-                .map(|s| crate::program::Segment {
-                    ticks: s.ticks,
-                    snap: s.snap * amp,
-                })
-                .collect(),
-        };
+        let program = unit.pieces.to_program(amp);
         program.validate(&f)?;
-        let (pk, end) = peaks(&program, &plan.start);
-        if pk.x > I256::from(Format::register_max(f.widths.x)) {
-            return Err(PlanError::Overflow {
-                quantity: "position",
-                needed: pk.x.as_f64().log2() + 1.0,
-                bits: f.widths.x,
-            });
-        }
+        // The chain is linear and starts at rest, so the move's peaks are |K| times the unit
+        // peaks, exactly; the position is monotonic, so its extremes are the two ends.
+        let kk = I256::from(k);
+        let start_x = I256::from(plan.start.x);
+        let end = crate::peaks::ExactState {
+            x: start_x + I256::from(sign) * kk * gain,
+            ..Default::default()
+        };
+        let pk = Peaks {
+            x: start_x.abs().max(end.x.abs()),
+            v: kk * unit.peaks.v,
+            a: kk * unit.peaks.a,
+            j: kk * unit.peaks.j,
+            d: kk * unit.peaks.d,
+        };
         plan.final_state = end.to_chain().expect("peaks fit their registers");
         plan.peaks = pk;
         plan.program = program;

@@ -36,7 +36,7 @@ pub struct TickLimits4 {
 /// Section 3.1: `t_d` and the snap after its last rounding (eqs 4–22).
 fn phase_d(l: &TickLimits4) -> (f64, f64) {
     // eqs 4–6: td from distance alone, x = 8·s·td⁴.
-    let mut td = ceil_ticks_min1((l.x / (8.0 * l.d)).powf(0.25)) as f64;
+    let mut td = ceil_ticks_min1((l.x / (8.0 * l.d)).sqrt().sqrt()) as f64;
     let mut s = l.x / (8.0 * td.powi(4));
     // eqs 7–11: velocity check, v_peak = 2·s·td³.
     if 2.0 * s * td.powi(3) > l.v {
