@@ -58,6 +58,15 @@ enum Command {
         #[arg(long)]
         svg: PathBuf,
     },
+    /// Print the fixed-point format: widths, range and resolution of every register.
+    Format {
+        /// Tick period Ts (s).
+        #[arg(long, default_value_t = snapgen_model::DEFAULT_FORMAT.ts, allow_hyphen_values = true)]
+        ts: f64,
+        /// Output position LSB (units).
+        #[arg(long, default_value_t = snapgen_model::DEFAULT_FORMAT.position_lsb, allow_hyphen_values = true)]
+        lsb: f64,
+    },
     /// The main job on built-in defaults: plan the seed 001 Table 1 and Table 3 moves and a
     /// seed 000 move, print the plans, write their plots.
     Demo {
@@ -112,6 +121,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plot::write_svg(&p, &title, &svg)
                 .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", svg.display()))?;
             eprintln!("wrote {}", svg.display());
+        }
+        Command::Format { ts, lsb } => {
+            let f = snapgen_model::Format {
+                ts,
+                position_lsb: lsb,
+                ..snapgen_model::DEFAULT_FORMAT
+            };
+            f.validate()
+                .map_err(PlanError::from)
+                .map_err(InputError::from)?;
+            print!("{}", report::format_table(&f));
         }
         Command::Demo { out } => demo::run(&out)?,
     }

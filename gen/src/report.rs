@@ -257,3 +257,57 @@ impl PlanReport {
         s
     }
 }
+
+/// The format as a Markdown table: widths, LSB and range of every register, and the limits on
+/// moves.
+pub fn format_table(f: &snapgen_model::Format) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Ts = {} s, output position LSB = {} units, {} fractional bits below it (internal LSB {:e} units)\n",
+        f.ts,
+        f.position_lsb,
+        FRAC_BITS,
+        f.internal_lsb()
+    );
+    let _ = writeln!(s, "| register | bits | LSB | largest magnitude |");
+    let _ = writeln!(s, "|---|---|---|---|");
+    for r in f.ranges() {
+        let _ = writeln!(
+            s,
+            "| {} ({}) | {} | {:.3e} | {:.3e} |",
+            r.quantity.name(),
+            r.quantity.unit(),
+            r.bits,
+            r.lsb,
+            r.max
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nlongest move: ±{:.6} units from the centre of cell 0 (±{} output LSBs)",
+        f.max_distance(),
+        (f.max_distance() / f.position_lsb).round()
+    );
+    let _ = writeln!(
+        s,
+        "longest duration: {} ticks = {:.1} s ({}-bit tick counter)",
+        (1u64 << f.tick_bits) - 1,
+        f.max_duration_s(),
+        f.tick_bits
+    );
+    let _ = writeln!(
+        s,
+        "exact endpoint: every move needs a position gain P < 2^{FRAC_BITS} (checked per plan; \
+         e.g. an order-4 move whose snap phases last {:.2} s or more is refused)",
+        // 8·td⁴ < 2^F  ⇒  td < (2^(F−3))^(1/4) ticks.
+        2f64.powf((FRAC_BITS as f64 - 3.0) / 4.0) * f.ts
+    );
+    let _ = writeln!(
+        s,
+        "program memory: {} segments of {}-bit ticks and {}-bit snap",
+        f.max_segments, f.tick_bits, f.widths.d
+    );
+    s
+}

@@ -142,6 +142,19 @@ impl Quantity {
     }
 }
 
+/// Range and resolution of one register in physical units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegisterRange {
+    /// What the register holds.
+    pub quantity: Quantity,
+    /// Its width.
+    pub bits: u32,
+    /// Physical value of one raw LSB.
+    pub lsb: f64,
+    /// Largest physical magnitude it holds.
+    pub max: f64,
+}
+
 impl Format {
     /// The default format with another tick period.
     pub fn with_ts(ts: f64) -> Self {
@@ -251,6 +264,30 @@ impl Format {
     pub fn position_physical(&self, x_raw: i128) -> f64 {
         let rel = PositionFix::from_bits(x_raw.wrapping_sub(self.home_raw()));
         rel.to_num::<f64>() * self.position_lsb
+    }
+
+    /// Range and resolution of every register, for documentation and `snapgen format`.
+    pub fn ranges(&self) -> Vec<RegisterRange> {
+        [
+            Quantity::Position,
+            Quantity::Velocity,
+            Quantity::Acceleration,
+            Quantity::Jerk,
+            Quantity::Snap,
+        ]
+        .into_iter()
+        .map(|q| RegisterRange {
+            quantity: q,
+            bits: self.width(q),
+            lsb: 1.0 / self.scale(q),
+            max: self.physical_max(q),
+        })
+        .collect()
+    }
+
+    /// Largest distance a move can have (both ways), from the centre of cell 0.
+    pub fn max_distance(&self) -> f64 {
+        (((1i128 << (self.widths.x - FRAC_BITS - 1)) - 2) as f64) * self.position_lsb
     }
 
     /// Longest duration, in seconds, that a program's total tick count can express.

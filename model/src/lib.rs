@@ -18,6 +18,6 @@ pub mod program;
 
 pub use chain::{ChainState, Sequencer, TickSample, Trace};
 pub use error::{FormatError, PlanError, ProgramError};
-pub use format::{Format, PositionFix, Quantity, Widths, DEFAULT_FORMAT, FRAC_BITS};
+pub use format::{Format, PositionFix, Quantity, RegisterRange, Widths, DEFAULT_FORMAT, FRAC_BITS};
 pub use planner::{plan, plan_from, Method, MoveRequest, PhaseTicks, Plan};
 pub use program::{Program, Segment, SnapTimeline};

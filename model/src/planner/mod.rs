@@ -362,10 +362,10 @@ pub fn plan_from(
     // Position range: output cells representable by the position register, with one cell of
     // headroom on each side.
     let cells = (1i128 << (f.widths.x - FRAC_BITS - 1)) - 1;
-    let max_distance = (cells - 1) as f64 * f.position_lsb;
+    let max_distance = f.max_distance();
     let target_f = (request.distance / f.position_lsb).round();
     let start_cell = f.output_lsb(start.x);
-    if target_f.abs() >= (cells - 1) as f64 || (start_cell + target_f as i128).abs() >= cells - 1 {
+    if target_f.abs() > (cells - 1) as f64 || (start_cell + target_f as i128).abs() > cells - 1 {
         return Err(PlanError::DistanceOutOfRange {
             distance: request.distance,
             max: max_distance,
