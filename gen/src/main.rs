@@ -6,6 +6,7 @@
 
 mod args;
 mod demo;
+mod hw;
 mod plot;
 mod report;
 mod trace;
@@ -58,6 +59,37 @@ enum Command {
         #[arg(long)]
         svg: PathBuf,
     },
+    /// Write the motion core's Verilog (top.v) and its Verilator waivers (verilator.vlt).
+    Verilog {
+        /// Output directory.
+        #[arg(long, default_value = "out/verilog")]
+        out: PathBuf,
+    },
+    /// Co-simulate random moves on the Verilated core against the model, clock by clock.
+    Cosim {
+        /// Moves to play.
+        #[arg(long, default_value_t = 100)]
+        moves: usize,
+        /// Seed of the random move stream.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Planners: 2, 3, 4 or mixed.
+        #[arg(long, default_value = "mixed")]
+        order: snapgen_sim::moves::OrderMix,
+        /// Dump the whole run's waves to this VCD file.
+        #[arg(long)]
+        vcd: Option<PathBuf>,
+        /// Where to write the waves around a mismatch.
+        #[arg(long, default_value = "cosim-mismatch.vcd")]
+        mismatch_vcd: PathBuf,
+        /// Also run the model alone and print the co-sim/model throughput ratio.
+        #[arg(long)]
+        bench: bool,
+        /// Test hook: flip BIT of REGISTER at CLOCK in the captured fabric stream
+        /// ("CLOCK:REGISTER:BIT"), to show that a one-bit difference is reported.
+        #[arg(long, hide = true)]
+        inject_fault: Option<String>,
+    },
     /// Print the fixed-point format: widths, range and resolution of every register.
     Format {
         /// Tick period Ts (s).
@@ -83,6 +115,26 @@ enum InputError {
     Args(#[from] ArgError),
     #[error(transparent)]
     Plan(#[from] PlanError),
+    #[error("--inject-fault {0:?}: use CLOCK:REGISTER:BIT, e.g. 1000:x:3")]
+    Fault(String),
+}
+
+/// The co-simulation found a difference (exit 1; the report is already printed).
+#[derive(Debug, thiserror::Error)]
+#[error("the fabric and the model disagree")]
+struct Mismatched;
+
+fn parse_fault(s: &str) -> Result<snapgen_sim::cosim::Fault, InputError> {
+    let bad = || InputError::Fault(s.to_string());
+    let mut it = s.split(':');
+    let (Some(c), Some(r), Some(b), None) = (it.next(), it.next(), it.next(), it.next()) else {
+        return Err(bad());
+    };
+    Ok(snapgen_sim::cosim::Fault {
+        clock: c.parse().map_err(|_| bad())?,
+        register: r.parse().map_err(|_| bad())?,
+        bit: b.parse().map_err(|_| bad())?,
+    })
 }
 
 fn make_plan(a: &PlanArgs) -> Result<Plan, InputError> {
@@ -132,6 +184,33 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .map_err(PlanError::from)
                 .map_err(InputError::from)?;
             print!("{}", report::format_table(&f));
+        }
+        Command::Verilog { out } => {
+            let files = hw::write_verilog(&out)?;
+            println!(
+                "wrote {} and {}",
+                files.verilog.display(),
+                files.waivers.display()
+            );
+        }
+        Command::Cosim {
+            moves,
+            seed,
+            order,
+            vcd,
+            mismatch_vcd,
+            bench,
+            inject_fault,
+        } => {
+            let mut cfg = snapgen_sim::cosim::CosimConfig::new(moves, seed);
+            cfg.mix = order;
+            cfg.vcd = vcd;
+            cfg.mismatch_vcd = mismatch_vcd;
+            cfg.fault = inject_fault.map(|s| parse_fault(&s)).transpose()?;
+            let r = hw::cosim(&cfg, bench)?;
+            if r.mismatch.is_some() || r.planner_disagreements > 0 {
+                return Err(anyhow::Error::new(Mismatched));
+            }
         }
         Command::Demo { out } => demo::run(&out)?,
     }

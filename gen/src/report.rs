@@ -189,7 +189,7 @@ impl PlanReport {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{} move of {} units (target {} = {} LSB of {}), Ts = {} s",
+            "{} move of {} units (target {} = {} LSB of {:e} units), Ts = {} s",
             self.method, self.distance, self.target, self.target_lsb, self.position_lsb, self.ts
         );
         if let (Some(v), Some(a), Some(j), Some(ta), Some(tj)) = (

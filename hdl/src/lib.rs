@@ -1,1 +1,65 @@
-//! rust-hdl description of the snapgen motion core. Not built yet: see issue 3.
+//! rust-hdl description of the snapgen motion core.
+//!
+//! One block per file: [`tick_divider`] (trajectory tick from the fabric clock),
+//! [`program_memory`] (two banks of segments, written while the other plays), [`sequencer`]
+//! (plays a program, one snap value per tick), [`chain`] (the four accumulators) and
+//! [`core`] (all of them wired together, the top level that `snapgen verilog` writes).
+//!
+//! Widths come from the model's [`DEFAULT_FORMAT`]: there is no second copy of the numbers.
+//! rust-hdl needs widths as const generics, so the generator supports the default register
+//! widths only; `Ts` and the position LSB do not change the hardware (the tick divider is an
+//! input).
+//!
+//! rust-hdl 0.46 workarounds used here (each is also noted where it is applied):
+//! * `#[hdl_gen]` drops Rust's operator precedence: every mixed expression is parenthesised.
+//! * Signed types are avoided (its simulator overflows the stack on `signed_bit_cast` of the
+//!   most negative value, and the casts lint with WIDTH warnings): registers are `Bits`
+//!   holding two's complement, addition is the same for both, and the one sign extension
+//!   (velocity into position) is an explicit mux on the sign bit.
+//! * Its simulator is slow past 32 bits: the blocks' own tests are short; long runs use
+//!   Verilator (`snapgen-sim`).
+
+pub mod chain;
+pub mod core;
+pub mod program_memory;
+pub mod sequencer;
+pub mod sign_extend;
+pub mod tick_divider;
+pub mod verilog;
+
+use snapgen_model::{DEFAULT_FORMAT, FRAC_BITS};
+
+/// Position register width.
+pub const X_BITS: usize = DEFAULT_FORMAT.widths.x as usize;
+/// Velocity register width.
+pub const V_BITS: usize = DEFAULT_FORMAT.widths.v as usize;
+/// Acceleration register width.
+pub const A_BITS: usize = DEFAULT_FORMAT.widths.a as usize;
+/// Jerk register width.
+pub const J_BITS: usize = DEFAULT_FORMAT.widths.j as usize;
+/// Snap (segment value) width.
+pub const D_BITS: usize = DEFAULT_FORMAT.widths.d as usize;
+/// Segment tick count and tick counter width.
+pub const TICK_BITS: usize = DEFAULT_FORMAT.tick_bits as usize;
+/// Fractional bits of the position register below the output LSB.
+pub const FRAC: usize = FRAC_BITS as usize;
+/// Width of the whole-LSB position output (`x >> FRAC`, truncated to 32 bits).
+pub const POSITION_BITS: usize = 32;
+/// Segment address within a bank: `max_segments` = 2^ADDR_BITS.
+pub const ADDR_BITS: usize = 5;
+/// Segment index and count width (holds 0..=2^ADDR_BITS).
+pub const INDEX_BITS: usize = ADDR_BITS + 1;
+/// Memory address: bank bit and segment address.
+pub const MEM_ADDR_BITS: usize = ADDR_BITS + 1;
+
+const _: () = {
+    assert!(
+        DEFAULT_FORMAT.max_segments == 1 << ADDR_BITS,
+        "the program memory depth must equal the format's max_segments"
+    );
+    assert!(
+        V_BITS == A_BITS && A_BITS == J_BITS && J_BITS == D_BITS,
+        "the generator supports equal v, a, j, d widths (sign extension is only into x)"
+    );
+    assert!(X_BITS > V_BITS && X_BITS <= 127 && X_BITS >= FRAC + POSITION_BITS);
+};

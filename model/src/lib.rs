@@ -10,6 +10,7 @@
 //! This crate does no I/O.
 
 pub mod chain;
+pub mod core;
 pub mod error;
 pub mod format;
 pub mod peaks;
@@ -17,6 +18,7 @@ pub mod planner;
 pub mod program;
 
 pub use chain::{ChainState, Sequencer, TickSample, Trace};
+pub use core::{CoreInputs, CoreModel, CoreOutputs};
 pub use error::{FormatError, PlanError, ProgramError};
 pub use format::{Format, PositionFix, Quantity, RegisterRange, Widths, DEFAULT_FORMAT, FRAC_BITS};
 pub use planner::{plan, plan_from, Method, MoveRequest, PhaseTicks, Plan};

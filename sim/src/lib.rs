@@ -1,1 +1,57 @@
-//! Verilator co-simulation of the generated core against the model. Not built yet: see issue 3.
+//! Verilator co-simulation: the generated Verilog of the motion core, built by Verilator into a
+//! shared library with a small C harness (`harness/harness.cpp`), runs clock by clock beside
+//! the clock-accurate model (`snapgen_model::CoreModel`); every output is compared on every
+//! clock.
+//!
+//! * [`build`] runs Verilator (cached by a hash of everything that goes into the build).
+//! * [`fabric`] loads the library and drives it.
+//! * [`cosim`] runs both in lockstep and reports the first mismatch.
+//! * [`moves`] makes the random move streams `snapgen cosim` plays.
+
+pub mod build;
+pub mod cosim;
+pub mod fabric;
+pub mod moves;
+
+use std::path::PathBuf;
+
+/// Errors of the co-simulation tool chain.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A tool is not installed.
+    #[error("{tool} was not found: {hint}")]
+    ToolMissing {
+        /// The tool.
+        tool: &'static str,
+        /// How to get it.
+        hint: &'static str,
+    },
+    /// A tool ran and failed.
+    #[error("{tool} failed (exit {code:?}); its output is in {log}")]
+    ToolFailed {
+        /// The tool.
+        tool: &'static str,
+        /// Exit code.
+        code: Option<i32>,
+        /// Log file.
+        log: PathBuf,
+    },
+    /// File system trouble.
+    #[error("{what} {path}: {source}")]
+    Io {
+        /// What was being done.
+        what: &'static str,
+        /// Where.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The built library does not load or does not match this harness.
+    #[error("cannot load the co-simulation library {path}: {reason}")]
+    Load {
+        /// Library path.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+}

@@ -1,0 +1,106 @@
+//! Program memory: two banks of `2^ADDR_BITS` segments (tick count and snap), one written
+//! while the other plays (double buffering). Synchronous write, asynchronous read — Yosys maps
+//! it to distributed LUT RAM on the 7 series — so the sequencer can fetch the next segment in
+//! the same clock and play one-tick segments back to back.
+//!
+//! rust-hdl has no asynchronous-read memory, so this block writes its Verilog by hand (as
+//! rust-hdl's own `RAM` does) and models the same behaviour for rust-hdl's simulator.
+
+use rust_hdl::prelude::*;
+
+use crate::{ADDR_BITS, D_BITS, MEM_ADDR_BITS, TICK_BITS};
+
+/// Two-bank segment memory.
+#[derive(LogicBlock, Default)]
+pub struct ProgramMemory {
+    /// Fabric clock (write side).
+    pub clock: Signal<In, Clock>,
+    /// Write strobe.
+    pub write_enable: Signal<In, Bit>,
+    /// Bank to write.
+    pub write_bank: Signal<In, Bit>,
+    /// Segment address to write.
+    pub write_address: Signal<In, Bits<ADDR_BITS>>,
+    /// Segment tick count to write.
+    pub write_ticks: Signal<In, Bits<TICK_BITS>>,
+    /// Segment snap to write.
+    pub write_snap: Signal<In, Bits<D_BITS>>,
+    /// Bank to read.
+    pub read_bank: Signal<In, Bit>,
+    /// Segment address to read (asynchronous).
+    pub read_address: Signal<In, Bits<ADDR_BITS>>,
+    /// Tick count at `read_address`.
+    pub read_ticks: Signal<Out, Bits<TICK_BITS>>,
+    /// Snap at `read_address`.
+    pub read_snap: Signal<Out, Bits<D_BITS>>,
+    _sim_ticks: Vec<Bits<TICK_BITS>>,
+    _sim_snap: Vec<Bits<D_BITS>>,
+}
+
+impl Logic for ProgramMemory {
+    fn update(&mut self) {
+        if self._sim_ticks.is_empty() {
+            self._sim_ticks = vec![Bits::default(); 1 << MEM_ADDR_BITS];
+            self._sim_snap = vec![Bits::default(); 1 << MEM_ADDR_BITS];
+        }
+        if self.clock.pos_edge() && self.write_enable.val() {
+            let a = self.write_address.val().index()
+                + (usize::from(self.write_bank.val()) << ADDR_BITS);
+            self._sim_ticks[a] = self.write_ticks.val();
+            self._sim_snap[a] = self.write_snap.val();
+        }
+        let r = self.read_address.val().index() + (usize::from(self.read_bank.val()) << ADDR_BITS);
+        self.read_ticks.next = self._sim_ticks[r];
+        self.read_snap.next = self._sim_snap[r];
+    }
+
+    fn connect(&mut self) {
+        self.read_ticks.connect();
+        self.read_snap.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(format!(
+            "\
+// Segment memory: {depth} entries, bank bit on top of the address.
+reg [{tmsb}:0] ticks_mem [0:{last}];
+reg [{dmsb}:0] snap_mem [0:{last}];
+integer i;
+initial begin
+   for (i = 0; i <= {last}; i = i + 1) begin
+      ticks_mem[i] = {tick_bits}'d0;
+      snap_mem[i] = {d_bits}'d0;
+   end
+end
+always @(posedge clock) begin
+   if (write_enable) begin
+      ticks_mem[{{write_bank, write_address}}] <= write_ticks;
+      snap_mem[{{write_bank, write_address}}] <= write_snap;
+   end
+end
+always @(*) begin
+   read_ticks = ticks_mem[{{read_bank, read_address}}];
+   read_snap = snap_mem[{{read_bank, read_address}}];
+end
+",
+            depth = 1 << MEM_ADDR_BITS,
+            last = (1 << MEM_ADDR_BITS) - 1,
+            tmsb = TICK_BITS - 1,
+            dmsb = D_BITS - 1,
+            tick_bits = TICK_BITS,
+            d_bits = D_BITS,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn program_memory_is_synthesizable() {
+        let mut uut = ProgramMemory::default();
+        uut.connect_all();
+        yosys_validate("program_memory", &generate_verilog(&uut)).unwrap();
+    }
+}

@@ -1,0 +1,182 @@
+//! Builds the Verilated core into a shared library, through the Verilator CLI:
+//!
+//! ```text
+//! verilator --cc --exe --build -O3 -Wall --top-module top verilator.vlt top.v harness.cpp
+//!           -CFLAGS "-fPIC -O2 -DSNAPGEN_TRACE=0|1" -LDFLAGS -shared -o libsnapgen_core.so
+//! ```
+//!
+//! Builds are cached in `$SNAPGEN_CACHE_DIR` (default `$XDG_CACHE_HOME/snapgen` or
+//! `~/.cache/snapgen`) under a hash of the Verilog, the waivers, the harness, the Verilator
+//! version and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
+//! warning that the waiver file does not waive fatal, so a build is also a lint check.
+//! `$SNAPGEN_VERILATOR` overrides the `verilator` binary.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::SimError;
+
+/// The harness source, compiled into every build.
+pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
+/// The Verilator waiver file for the generated core.
+pub const WAIVERS_VLT: &str = include_str!("../../hdl/verilator.vlt");
+
+/// The Verilator binary to use.
+pub fn verilator_bin() -> String {
+    std::env::var("SNAPGEN_VERILATOR").unwrap_or_else(|_| "verilator".into())
+}
+
+fn missing_verilator() -> SimError {
+    SimError::ToolMissing {
+        tool: "verilator",
+        hint:
+            "install it (Debian/Ubuntu: apt-get install verilator) or point SNAPGEN_VERILATOR at it",
+    }
+}
+
+/// `verilator --version`, or a typed error if it is not installed.
+pub fn verilator_version() -> Result<String, SimError> {
+    let out = Command::new(verilator_bin())
+        .arg("--version")
+        .output()
+        .map_err(|_| missing_verilator())?;
+    if !out.status.success() {
+        return Err(missing_verilator());
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+/// The cache root.
+pub fn cache_root() -> PathBuf {
+    if let Ok(d) = std::env::var("SNAPGEN_CACHE_DIR") {
+        return PathBuf::from(d);
+    }
+    if let Ok(d) = std::env::var("XDG_CACHE_HOME") {
+        return PathBuf::from(d).join("snapgen");
+    }
+    if let Ok(h) = std::env::var("HOME") {
+        return PathBuf::from(h).join(".cache").join("snapgen");
+    }
+    std::env::temp_dir().join("snapgen")
+}
+
+/// FNV-1a, 64 bit: a stable content hash for the cache key.
+fn fnv1a(parts: &[&[u8]]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in parts {
+        for &b in *p {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+fn io<'p>(what: &'static str, path: &'p Path) -> impl FnOnce(std::io::Error) -> SimError + 'p {
+    move |source| SimError::Io {
+        what,
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// A built co-simulation library.
+#[derive(Clone, Debug)]
+pub struct Built {
+    /// The shared library.
+    pub library: PathBuf,
+    /// True if it was already in the cache.
+    pub cached: bool,
+}
+
+/// Builds (or finds in the cache) the library for `verilog`, with VCD tracing if `trace`.
+pub fn build(verilog: &str, trace: bool) -> Result<Built, SimError> {
+    let version = verilator_version()?;
+    let key = fnv1a(&[
+        verilog.as_bytes(),
+        WAIVERS_VLT.as_bytes(),
+        HARNESS_CPP.as_bytes(),
+        version.as_bytes(),
+        &[u8::from(trace)],
+    ]);
+    let root = cache_root();
+    let dir = root.join(format!(
+        "core-{key:016x}{}",
+        if trace { "-trace" } else { "" }
+    ));
+    let library = dir.join("libsnapgen_core.so");
+    if library.exists() {
+        return Ok(Built {
+            library,
+            cached: true,
+        });
+    }
+    // Build in a private directory, then rename it into place: concurrent builds of the same
+    // design (parallel tests) never see a half-written library.
+    let tmp = root.join(format!(
+        "build-{key:016x}-{}-{}",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos())
+    ));
+    fs::create_dir_all(&tmp).map_err(io("cannot create", &tmp))?;
+    let write = |name: &str, text: &str| {
+        let p = tmp.join(name);
+        fs::write(&p, text).map_err(io("cannot write", &p))
+    };
+    write("top.v", verilog)?;
+    write("verilator.vlt", WAIVERS_VLT)?;
+    write("harness.cpp", HARNESS_CPP)?;
+    let log = tmp.join("build.log");
+    let mut cmd = Command::new(verilator_bin());
+    cmd.current_dir(&tmp)
+        .args(["--cc", "--exe", "--build", "-j", "2", "-O3", "-Wall"])
+        .args(["--x-assign", "fast", "--x-initial", "fast", "--noassert"])
+        .args(["--top-module", "top", "--Mdir", "obj"])
+        .args([
+            "-CFLAGS",
+            &format!(
+                "-fPIC -O3 -march=native -DSNAPGEN_TRACE={}",
+                u8::from(trace)
+            ),
+        ])
+        .args(["-LDFLAGS", "-shared", "-o", "libsnapgen_core.so"]);
+    if trace {
+        cmd.arg("--trace");
+    }
+    cmd.args(["verilator.vlt", "top.v", "harness.cpp"]);
+    let out = cmd.output().map_err(|_| missing_verilator())?;
+    let mut text = out.stdout.clone();
+    text.extend_from_slice(&out.stderr);
+    fs::write(&log, &text).map_err(io("cannot write", &log))?;
+    if !out.status.success() {
+        return Err(SimError::ToolFailed {
+            tool: "verilator",
+            code: out.status.code(),
+            log,
+        });
+    }
+    let built = tmp.join("obj").join("libsnapgen_core.so");
+    fs::rename(&built, tmp.join("libsnapgen_core.so")).map_err(io("cannot move", &built))?;
+    // Keep the sources and the log beside the library; drop the object files.
+    let _ = fs::remove_dir_all(tmp.join("obj"));
+    if fs::rename(&tmp, &dir).is_err() {
+        // Another build of the same design won the race; use it.
+        let _ = fs::remove_dir_all(&tmp);
+        if !library.exists() {
+            return Err(SimError::Io {
+                what: "cannot install the build into",
+                path: dir,
+                source: std::io::Error::other("rename failed"),
+            });
+        }
+    }
+    Ok(Built {
+        library,
+        cached: false,
+    })
+}

@@ -1,0 +1,502 @@
+//! Lockstep co-simulation of the Verilated core and the clock-accurate model.
+//!
+//! A session resets the core, then for each move plans it from the model's exact state, writes
+//! its segments into the standby bank, starts it and clocks until it is done (or stops it
+//! midway). Fabric and model receive the same inputs on every clock and every output — x, v,
+//! a, j, position, segment index, busy, done, aborted, tick count, tick, active bank — is
+//! compared after every rising edge. The first mismatch ends the session; it is then re-run
+//! with a trace build to write the waves around it.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use snapgen_model::{plan_from, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT};
+
+use crate::build::build;
+use crate::fabric::{decode, Fabric, VcdWindow, OUT_WORDS};
+use crate::moves::{MoveStream, OrderMix};
+use crate::SimError;
+
+/// Clocks per call into the fabric.
+const BATCH: u64 = 1 << 16;
+/// Longest move the stream keeps, in ticks (keeps CI runs bounded).
+const MAX_MOVE_TICKS: u64 = 400_000;
+
+/// A compared output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Register {
+    /// Position register.
+    X,
+    /// Velocity register.
+    V,
+    /// Acceleration register.
+    A,
+    /// Jerk register.
+    J,
+    /// Whole-LSB position output.
+    Position,
+    /// Segment index.
+    Segment,
+    /// Busy flag.
+    Busy,
+    /// Done flag.
+    Done,
+    /// Aborted flag.
+    Aborted,
+    /// Tick counter.
+    TickCount,
+    /// Tick enable.
+    Tick,
+    /// Active bank.
+    ActiveBank,
+}
+
+impl Register {
+    /// Every register, in comparison order.
+    pub const ALL: [Register; 12] = [
+        Register::X,
+        Register::V,
+        Register::A,
+        Register::J,
+        Register::Position,
+        Register::Segment,
+        Register::Busy,
+        Register::Done,
+        Register::Aborted,
+        Register::TickCount,
+        Register::Tick,
+        Register::ActiveBank,
+    ];
+
+    /// Its name (as the Verilog port).
+    pub fn name(self) -> &'static str {
+        match self {
+            Register::X => "x",
+            Register::V => "v",
+            Register::A => "a",
+            Register::J => "j",
+            Register::Position => "position",
+            Register::Segment => "segment",
+            Register::Busy => "busy",
+            Register::Done => "done",
+            Register::Aborted => "aborted",
+            Register::TickCount => "tick_count",
+            Register::Tick => "tick",
+            Register::ActiveBank => "active_bank",
+        }
+    }
+
+    /// Its width in bits.
+    pub fn bits(self, f: &Format) -> u32 {
+        match self {
+            Register::X => f.widths.x,
+            Register::V => f.widths.v,
+            Register::A => f.widths.a,
+            Register::J => f.widths.j,
+            Register::Position | Register::TickCount => 32,
+            Register::Segment => 6,
+            _ => 1,
+        }
+    }
+
+    /// Its raw bits in `o`, as an unsigned pattern of `bits` bits.
+    pub fn bits_of(self, o: &CoreOutputs, f: &Format) -> u128 {
+        let mask = |v: i128, b: u32| (v as u128) & (u128::MAX >> (128 - b));
+        match self {
+            Register::X => mask(o.x, f.widths.x),
+            Register::V => mask(o.v, f.widths.v),
+            Register::A => mask(o.a, f.widths.a),
+            Register::J => mask(o.j, f.widths.j),
+            Register::Position => u128::from(o.position),
+            Register::Segment => u128::from(o.segment),
+            Register::Busy => u128::from(o.busy),
+            Register::Done => u128::from(o.done),
+            Register::Aborted => u128::from(o.aborted),
+            Register::TickCount => u128::from(o.tick_count),
+            Register::Tick => u128::from(o.tick),
+            Register::ActiveBank => u128::from(o.active_bank),
+        }
+    }
+
+    /// `o` with bit `bit` of this register flipped.
+    pub fn flip(self, o: &mut CoreOutputs, bit: u32, f: &Format) {
+        let b = bit % self.bits(f);
+        let w = |v: &mut i128, bits: u32| {
+            *v = snapgen_model::chain::wrap(*v ^ (1i128 << b), bits);
+        };
+        match self {
+            Register::X => w(&mut o.x, f.widths.x),
+            Register::V => w(&mut o.v, f.widths.v),
+            Register::A => w(&mut o.a, f.widths.a),
+            Register::J => w(&mut o.j, f.widths.j),
+            Register::Position => o.position ^= 1 << b,
+            Register::Segment => o.segment ^= 1 << b,
+            Register::Busy => o.busy = !o.busy,
+            Register::Done => o.done = !o.done,
+            Register::Aborted => o.aborted = !o.aborted,
+            Register::TickCount => o.tick_count ^= 1 << b,
+            Register::Tick => o.tick = !o.tick,
+            Register::ActiveBank => o.active_bank = !o.active_bank,
+        }
+    }
+}
+
+impl std::str::FromStr for Register {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Register::ALL
+            .into_iter()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| format!("unknown register {s:?}"))
+    }
+}
+
+/// A deliberate one-bit error in the captured fabric stream, to prove the comparison fails.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fault {
+    /// Clock at which to flip.
+    pub clock: u64,
+    /// Register to flip.
+    pub register: Register,
+    /// Bit to flip.
+    pub bit: u32,
+}
+
+/// The first difference between fabric and model.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Mismatch {
+    /// Clock (rising edges since power-up, from 0).
+    pub clock: u64,
+    /// Move being played (0-based).
+    pub move_index: usize,
+    /// Register that differs.
+    pub register: Register,
+    /// Model's bits.
+    pub expected: u128,
+    /// Fabric's bits.
+    pub actual: u128,
+    /// Width of the register.
+    pub bits: u32,
+}
+
+impl std::fmt::Display for Mismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let digits = self.bits.div_ceil(4) as usize;
+        write!(
+            f,
+            "first mismatch at clock {} (move {}): register {} expected {:#0w$x} got {:#0w$x} (differing bits {:#x})",
+            self.clock,
+            self.move_index,
+            self.register.name(),
+            self.expected,
+            self.actual,
+            self.expected ^ self.actual,
+            w = digits + 2
+        )
+    }
+}
+
+/// Settings of a co-simulation run.
+#[derive(Clone, Debug)]
+pub struct CosimConfig {
+    /// Moves to play.
+    pub moves: usize,
+    /// Seed of the move stream.
+    pub seed: u64,
+    /// Planners to use.
+    pub mix: OrderMix,
+    /// Dump the whole run's waves here.
+    pub vcd: Option<PathBuf>,
+    /// Where to write the waves around a mismatch.
+    pub mismatch_vcd: PathBuf,
+    /// A deliberate fault (tests).
+    pub fault: Option<Fault>,
+    /// Show a progress bar (only when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl CosimConfig {
+    /// Defaults for `moves` moves from `seed`.
+    pub fn new(moves: usize, seed: u64) -> Self {
+        CosimConfig {
+            moves,
+            seed,
+            mix: OrderMix::Mixed,
+            vcd: None,
+            mismatch_vcd: PathBuf::from("cosim-mismatch.vcd"),
+            fault: None,
+            progress: true,
+        }
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Debug, Default)]
+pub struct CosimReport {
+    /// Moves played.
+    pub moves: usize,
+    /// Moves stopped midway.
+    pub stopped: usize,
+    /// Moves the stream drew but the planner refused or that were too long (skipped).
+    pub skipped: usize,
+    /// Clocks compared.
+    pub clocks: u64,
+    /// Ticks compared (clocks on which the chain stepped).
+    pub ticks: u64,
+    /// Seconds spent clocking and comparing.
+    pub seconds: f64,
+    /// The first mismatch.
+    pub mismatch: Option<Mismatch>,
+    /// Waves written.
+    pub vcd: Option<PathBuf>,
+    /// The library was already built.
+    pub cached_build: bool,
+    /// Moves after which the clock-accurate model did not stand where the planner said.
+    pub planner_disagreements: usize,
+}
+
+impl CosimReport {
+    /// Ticks per second.
+    pub fn ticks_per_second(&self) -> f64 {
+        self.ticks as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// The two sides in lockstep.
+struct Lockstep {
+    fabric: Option<Fabric>,
+    model: CoreModel,
+    format: Format,
+    clock: u64,
+    ticks: u64,
+    buf: Vec<u32>,
+    fault: Option<Fault>,
+    move_index: usize,
+}
+
+impl Lockstep {
+    /// `n` clocks with inputs `i` on both sides, compared.
+    fn drive(&mut self, i: &CoreInputs, n: u64) -> Result<(), Mismatch> {
+        let f = self.format;
+        if let Some(fab) = self.fabric.as_mut() {
+            fab.set(i);
+        }
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(BATCH);
+            match self.fabric.as_mut() {
+                Some(fab) => {
+                    fab.run(k as usize, &mut self.buf);
+                    for c in 0..k as usize {
+                        let ticked = self.model.outputs().tick;
+                        let m = self.model.clock(i);
+                        let mut o = decode(&self.buf[c * OUT_WORDS..(c + 1) * OUT_WORDS], &f);
+                        if let Some(fl) = self.fault {
+                            if fl.clock == self.clock {
+                                fl.register.flip(&mut o, fl.bit, &f);
+                            }
+                        }
+                        if m != o {
+                            let register = Register::ALL
+                                .into_iter()
+                                .find(|r| r.bits_of(&m, &f) != r.bits_of(&o, &f))
+                                .expect("outputs differ in some register");
+                            return Err(Mismatch {
+                                clock: self.clock,
+                                move_index: self.move_index,
+                                register,
+                                expected: register.bits_of(&m, &f),
+                                actual: register.bits_of(&o, &f),
+                                bits: register.bits(&f),
+                            });
+                        }
+                        self.ticks += u64::from(ticked);
+                        self.clock += 1;
+                    }
+                }
+                None => {
+                    // Model only (the benchmark's reference).
+                    for _ in 0..k {
+                        let ticked = self.model.outputs().tick;
+                        std::hint::black_box(self.model.clock(i));
+                        self.ticks += u64::from(ticked);
+                        self.clock += 1;
+                    }
+                }
+            }
+            left -= k;
+        }
+        Ok(())
+    }
+}
+
+/// Plays the session on `fabric` (or on the model alone when `None`).
+fn session(
+    cfg: &CosimConfig,
+    fabric: Option<Fabric>,
+    report: &mut CosimReport,
+) -> Result<(), Mismatch> {
+    let format = DEFAULT_FORMAT;
+    let mut ls = Lockstep {
+        fabric,
+        model: CoreModel::new(&format),
+        format,
+        clock: 0,
+        ticks: 0,
+        buf: Vec::new(),
+        fault: cfg.fault,
+        move_index: 0,
+    };
+    let bar = if cfg.progress && std::io::stderr().is_terminal() {
+        let b = ProgressBar::new(cfg.moves as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} moves, {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let start_time = Instant::now();
+    let result = (|| {
+        ls.drive(
+            &CoreInputs {
+                reset: true,
+                ..Default::default()
+            },
+            2,
+        )?;
+        let mut stream = MoveStream::new(cfg.seed, cfg.mix);
+        let mut played = 0;
+        while played < cfg.moves {
+            let spec = stream.next_move();
+            let f = Format::with_ts(spec.ts);
+            let plan = match plan_from(&spec.request, &f, ls.model.chain()) {
+                Ok(p) if p.ticks_total() <= MAX_MOVE_TICKS => p,
+                _ => {
+                    report.skipped += 1;
+                    continue;
+                }
+            };
+            ls.move_index = played;
+            let idle = CoreInputs {
+                tick_div: spec.tick_div,
+                ..Default::default()
+            };
+            for (k, s) in plan.program.segments.iter().enumerate() {
+                ls.drive(
+                    &CoreInputs {
+                        write_enable: true,
+                        write_address: k as u8,
+                        write_ticks: s.ticks,
+                        write_snap: s.snap,
+                        ..idle
+                    },
+                    1,
+                )?;
+            }
+            ls.drive(
+                &CoreInputs {
+                    count_enable: true,
+                    count_value: plan.program.segments.len() as u8,
+                    ..idle
+                },
+                1,
+            )?;
+            ls.drive(
+                &CoreInputs {
+                    start: true,
+                    ..idle
+                },
+                1,
+            )?;
+            let per_tick = u64::from(spec.tick_div) + 1;
+            let mut budget = (plan.ticks_total() + 2) * per_tick + 2;
+            if let Some(after) = spec.stop_after {
+                ls.drive(&idle, after.min(budget))?;
+                ls.drive(&CoreInputs { stop: true, ..idle }, 1)?;
+                report.stopped += 1;
+            } else {
+                while ls.model.busy() && budget > 0 {
+                    let k = budget.min(BATCH);
+                    ls.drive(&idle, k)?;
+                    budget -= k;
+                }
+                // The clock-accurate model must land where the planner said.
+                if ls.model.chain() != plan.final_state {
+                    report.planner_disagreements += 1;
+                }
+            }
+            // A few idle clocks between moves, compared too.
+            ls.drive(&idle, 3)?;
+            played += 1;
+            report.moves = played;
+            bar.inc(1);
+            bar.set_message(format!("{} ticks", ls.ticks));
+        }
+        Ok(())
+    })();
+    bar.finish_and_clear();
+    report.seconds = start_time.elapsed().as_secs_f64();
+    report.clocks = ls.clock;
+    report.ticks = ls.ticks;
+    result
+}
+
+/// Runs a co-simulation of `verilog` (the motion core) against the model.
+pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
+    let built = build(verilog, cfg.vcd.is_some())?;
+    let window = cfg.vcd.as_ref().map(|p| VcdWindow {
+        path: p.clone(),
+        from: 0,
+        to: u64::MAX,
+    });
+    let fabric = Fabric::open(&built.library, window.as_ref())?;
+    let mut report = CosimReport {
+        cached_build: built.cached,
+        vcd: cfg.vcd.clone(),
+        ..Default::default()
+    };
+    if let Err(m) = session(cfg, Some(fabric), &mut report) {
+        // Re-run with a trace build and dump the clocks around the mismatch.
+        if cfg.vcd.is_none() {
+            let traced = build(verilog, true)?;
+            let w = VcdWindow {
+                path: cfg.mismatch_vcd.clone(),
+                from: m.clock.saturating_sub(64),
+                to: m.clock + 16,
+            };
+            let fab = Fabric::open(&traced.library, Some(&w))?;
+            let mut again = CosimReport::default();
+            let _ = session(
+                &CosimConfig {
+                    progress: false,
+                    ..cfg.clone()
+                },
+                Some(fab),
+                &mut again,
+            );
+            report.vcd = Some(cfg.mismatch_vcd.clone());
+        }
+        report.mismatch = Some(m);
+    }
+    Ok(report)
+}
+
+/// Runs the same session on the model alone (no fabric): the reference for the co-sim/model
+/// throughput ratio.
+pub fn run_model_only(cfg: &CosimConfig) -> CosimReport {
+    let mut report = CosimReport::default();
+    let _ = session(
+        &CosimConfig {
+            progress: false,
+            fault: None,
+            ..cfg.clone()
+        },
+        None,
+        &mut report,
+    );
+    report
+}
