@@ -10,6 +10,7 @@ mod hw;
 mod plot;
 mod report;
 mod trace;
+mod yosys;
 
 use std::fs::File;
 use std::path::PathBuf;

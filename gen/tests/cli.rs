@@ -353,11 +353,44 @@ fn demo_runs_and_writes_plots() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("round trip 0 -> 12π -> 0 ends on the start register bit for bit"));
+    assert!(stdout.contains(", 0 mismatches"), "{stdout}");
+    assert!(stdout.contains(" 0 latches"), "{stdout}");
     for f in [
         "seed001_table1.svg",
         "seed001_table3_return.svg",
         "seed000_all_limits.svg",
     ] {
         assert!(dir.join(f).exists(), "{f} not written");
+    }
+}
+
+#[test]
+fn verilog_is_lint_clean_under_wall() {
+    let dir = tmp("verilog");
+    let out = snapgen(&["verilog", "--out", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lint = Command::new("verilator")
+        .args(["--lint-only", "-Wall", "--top-module", "top"])
+        .arg(dir.join("verilator.vlt"))
+        .arg(dir.join("top.v"))
+        .output()
+        .expect("verilator is installed by the test command");
+    let text = String::from_utf8_lossy(&lint.stderr);
+    assert!(lint.status.success(), "{text}");
+    assert!(!text.contains("%Warning"), "{text}");
+    // Every waiver carries a reason: a comment line right above each lint_off.
+    let vlt = std::fs::read_to_string(dir.join("verilator.vlt")).unwrap();
+    let lines: Vec<&str> = vlt.lines().collect();
+    for (i, l) in lines.iter().enumerate() {
+        if l.starts_with("lint_off") {
+            assert!(
+                lines[i - 1].starts_with("//"),
+                "waiver without a reason: {l}"
+            );
+        }
     }
 }

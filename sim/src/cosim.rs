@@ -16,7 +16,7 @@ use snapgen_model::{plan_from, CoreInputs, CoreModel, CoreOutputs, Format, DEFAU
 
 use crate::build::build;
 use crate::fabric::{decode, Fabric, VcdWindow, OUT_WORDS};
-use crate::moves::{MoveStream, OrderMix};
+use crate::moves::{MoveSpec, MoveStream, OrderMix};
 use crate::SimError;
 
 /// Clocks per call into the fabric.
@@ -215,6 +215,8 @@ pub struct CosimConfig {
     pub fault: Option<Fault>,
     /// Show a progress bar (only when stderr is a terminal).
     pub progress: bool,
+    /// Play these moves instead of a random stream (`moves` and `seed` are then ignored).
+    pub fixed: Option<Vec<MoveSpec>>,
 }
 
 impl CosimConfig {
@@ -228,6 +230,16 @@ impl CosimConfig {
             mismatch_vcd: PathBuf::from("cosim-mismatch.vcd"),
             fault: None,
             progress: true,
+            fixed: None,
+        }
+    }
+
+    /// A run of the given moves, in order.
+    pub fn fixed(moves: Vec<MoveSpec>) -> Self {
+        CosimConfig {
+            moves: moves.len(),
+            fixed: Some(moves),
+            ..CosimConfig::new(0, 0)
         }
     }
 }
@@ -243,7 +255,7 @@ pub struct CosimReport {
     pub skipped: usize,
     /// Clocks compared.
     pub clocks: u64,
-    /// Ticks compared (clocks on which the chain stepped).
+    /// Program ticks compared (clocks on which the chain stepped with a program playing).
     pub ticks: u64,
     /// Seconds spent clocking and comparing.
     pub seconds: f64,
@@ -290,7 +302,7 @@ impl Lockstep {
                 Some(fab) => {
                     fab.run(k as usize, &mut self.buf);
                     for c in 0..k as usize {
-                        let ticked = self.model.outputs().tick;
+                        let ticked = self.model.outputs().tick && self.model.busy();
                         let m = self.model.clock(i);
                         let mut o = decode(&self.buf[c * OUT_WORDS..(c + 1) * OUT_WORDS], &f);
                         if let Some(fl) = self.fault {
@@ -319,7 +331,7 @@ impl Lockstep {
                 None => {
                     // Model only (the benchmark's reference).
                     for _ in 0..k {
-                        let ticked = self.model.outputs().tick;
+                        let ticked = self.model.outputs().tick && self.model.busy();
                         std::hint::black_box(self.model.clock(i));
                         self.ticks += u64::from(ticked);
                         self.clock += 1;
@@ -369,9 +381,16 @@ fn session(
             2,
         )?;
         let mut stream = MoveStream::new(cfg.seed, cfg.mix);
+        let mut fixed = cfg.fixed.iter().flatten();
         let mut played = 0;
         while played < cfg.moves {
-            let spec = stream.next_move();
+            let spec = match cfg.fixed {
+                Some(_) => match fixed.next() {
+                    Some(s) => *s,
+                    None => break,
+                },
+                None => stream.next_move(),
+            };
             let f = Format::with_ts(spec.ts);
             let plan = match plan_from(&spec.request, &f, ls.model.chain()) {
                 Ok(p) if p.ticks_total() <= MAX_MOVE_TICKS => p,
