@@ -234,6 +234,12 @@ impl CoreModel {
         self.outputs()
     }
 
+    /// Changes the `tick_div` input between edges (the combinational `tick` output follows it
+    /// at once, as the hardware's does).
+    pub fn set_tick_div(&mut self, tick_div: u32) {
+        self.tick_div = tick_div;
+    }
+
     /// The outputs as they stand (after the last edge, with the last `tick_div`).
     pub fn outputs(&self) -> CoreOutputs {
         CoreOutputs {

@@ -7,6 +7,12 @@
 #include <cstring>
 #include "Vtop.h"
 #include "verilated.h"
+#include "Vtop___024root.h"
+
+// The model's evaluation function. `Vtop::eval()` wraps it with per-call bookkeeping
+// (message queue, thread-local context) that cost ~35 ns per call here; after the first
+// `eval()` (which runs the initial blocks) the harness calls it directly.
+void Vtop___024root___eval(Vtop___024root* vlSelf);
 #if SNAPGEN_TRACE
 #include "verilated_vcd_c.h"
 #endif
@@ -107,7 +113,7 @@ void snapgen_core_run(void* h, uint64_t n, uint32_t* out) {
     Vtop* t = c->top;
     for (uint64_t i = 0; i < n; ++i) {
         t->clock = 1;
-        t->eval();
+        Vtop___024root___eval(t->rootp);
         dump(c, 2 * c->cycle + 1);
         uint32_t* o = out + i * OUT_WORDS;
         copy4(o + OUT_X0, t->x);
@@ -120,7 +126,7 @@ void snapgen_core_run(void* h, uint64_t n, uint32_t* out) {
                        ((uint32_t)t->tick << 11) | ((uint32_t)t->active_bank << 12);
         o[OUT_TICK_COUNT] = t->tick_count;
         t->clock = 0;
-        t->eval();
+        Vtop___024root___eval(t->rootp);
         c->cycle++;
         dump(c, 2 * c->cycle);
     }

@@ -92,8 +92,11 @@ pub struct Built {
     pub cached: bool,
 }
 
-/// Builds (or finds in the cache) the library for `verilog`, with VCD tracing if `trace`.
-pub fn build(verilog: &str, trace: bool) -> Result<Built, SimError> {
+/// Builds (or finds in the cache) the co-simulation library for the core `verilog` (wrapped by
+/// [`crate::wrapper::cosim_top`]), with VCD tracing if `trace`.
+pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
+    let verilog = crate::wrapper::cosim_top(core_verilog);
+    let verilog = verilog.as_str();
     let version = verilator_version()?;
     let key = fnv1a(&[
         verilog.as_bytes(),

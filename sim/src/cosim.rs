@@ -15,7 +15,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use snapgen_model::{plan_from, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT};
 
 use crate::build::build;
-use crate::fabric::{decode, Fabric, VcdWindow, OUT_WORDS};
+use crate::fabric::{decode, encode, Fabric, VcdWindow, OUT_WORDS};
 use crate::moves::{MoveSpec, MoveStream, OrderMix};
 use crate::SimError;
 
@@ -167,7 +167,9 @@ pub struct Fault {
 /// The first difference between fabric and model.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Mismatch {
-    /// Clock (rising edges since power-up, from 0).
+    /// Parallel session that found it (each session is its own core and move stream).
+    pub session: usize,
+    /// Clock (rising edges since power-up of that session's core, from 0).
     pub clock: u64,
     /// Move being played (0-based).
     pub move_index: usize,
@@ -186,7 +188,8 @@ impl std::fmt::Display for Mismatch {
         let digits = self.bits.div_ceil(4) as usize;
         write!(
             f,
-            "first mismatch at clock {} (move {}): register {} expected {:#0w$x} got {:#0w$x} (differing bits {:#x})",
+            "first mismatch in session {} at clock {} (move {}): register {} expected {:#0w$x} got {:#0w$x} (differing bits {:#x})",
+            self.session,
             self.clock,
             self.move_index,
             self.register.name(),
@@ -217,6 +220,11 @@ pub struct CosimConfig {
     pub progress: bool,
     /// Play these moves instead of a random stream (`moves` and `seed` are then ignored).
     pub fixed: Option<Vec<MoveSpec>>,
+    /// Parallel sessions for a random stream (each its own core, model and sub-stream);
+    /// 1 with `vcd` or `fixed`.
+    pub threads: usize,
+    /// Index of this session (set by `run`).
+    pub session: usize,
 }
 
 impl CosimConfig {
@@ -231,7 +239,36 @@ impl CosimConfig {
             fault: None,
             progress: true,
             fixed: None,
+            threads: std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(2),
+            session: 0,
         }
+    }
+
+    /// The sessions this run splits into: session `s` of `n` plays every move of the stream
+    /// seeded with `seed` (s = 0) or `seed ^ s·φ` (s > 0), `moves / n` of them (the first
+    /// sessions take the remainder). The fault goes to session 0.
+    pub fn sessions(&self) -> Vec<CosimConfig> {
+        let n = if self.fixed.is_some() || self.vcd.is_some() {
+            1
+        } else {
+            self.threads.clamp(1, self.moves.max(1))
+        };
+        (0..n)
+            .map(|s| CosimConfig {
+                moves: self.moves / n + usize::from(s < self.moves % n),
+                seed: if s == 0 {
+                    self.seed
+                } else {
+                    self.seed ^ (s as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                },
+                fault: if s == 0 { self.fault } else { None },
+                threads: 1,
+                session: s,
+                ..self.clone()
+            })
+            .collect()
     }
 
     /// A run of the given moves, in order.
@@ -286,6 +323,10 @@ struct Lockstep {
     buf: Vec<u32>,
     fault: Option<Fault>,
     move_index: usize,
+    /// Inputs of the previous clock: the fabric's wrapper registers every input, so the core
+    /// sees them one clock late, and so does the model.
+    pending: CoreInputs,
+    session: usize,
 }
 
 impl Lockstep {
@@ -303,19 +344,30 @@ impl Lockstep {
                     fab.run(k as usize, &mut self.buf);
                     for c in 0..k as usize {
                         let ticked = self.model.outputs().tick && self.model.busy();
-                        let m = self.model.clock(i);
-                        let mut o = decode(&self.buf[c * OUT_WORDS..(c + 1) * OUT_WORDS], &f);
-                        if let Some(fl) = self.fault {
-                            if fl.clock == self.clock {
+                        self.model.clock(&self.pending);
+                        // The registered tick_div already holds this clock's value, and the
+                        // combinational `tick` output compares against it.
+                        self.model.set_tick_div(i.tick_div);
+                        let m = self.model.outputs();
+                        self.pending = *i;
+                        let words = &self.buf[c * OUT_WORDS..(c + 1) * OUT_WORDS];
+                        let faulty = self.fault.is_some_and(|fl| fl.clock == self.clock);
+                        if faulty || encode(&m, &f) != words {
+                            let mut o = decode(words, &f);
+                            if let Some(fl) = self.fault.filter(|_| faulty) {
                                 fl.register.flip(&mut o, fl.bit, &f);
                             }
-                        }
-                        if m != o {
+                            if m == o {
+                                self.ticks += u64::from(ticked);
+                                self.clock += 1;
+                                continue;
+                            }
                             let register = Register::ALL
                                 .into_iter()
                                 .find(|r| r.bits_of(&m, &f) != r.bits_of(&o, &f))
                                 .expect("outputs differ in some register");
                             return Err(Mismatch {
+                                session: self.session,
                                 clock: self.clock,
                                 move_index: self.move_index,
                                 register,
@@ -332,7 +384,8 @@ impl Lockstep {
                     // Model only (the benchmark's reference).
                     for _ in 0..k {
                         let ticked = self.model.outputs().tick && self.model.busy();
-                        std::hint::black_box(self.model.clock(i));
+                        std::hint::black_box(self.model.clock(&self.pending));
+                        self.pending = *i;
                         self.ticks += u64::from(ticked);
                         self.clock += 1;
                     }
@@ -349,6 +402,7 @@ fn session(
     cfg: &CosimConfig,
     fabric: Option<Fabric>,
     report: &mut CosimReport,
+    bar: &ProgressBar,
 ) -> Result<(), Mismatch> {
     let format = DEFAULT_FORMAT;
     let mut ls = Lockstep {
@@ -360,16 +414,8 @@ fn session(
         buf: Vec::new(),
         fault: cfg.fault,
         move_index: 0,
-    };
-    let bar = if cfg.progress && std::io::stderr().is_terminal() {
-        let b = ProgressBar::new(cfg.moves as u64);
-        b.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} moves, {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
+        pending: CoreInputs::default(),
+        session: cfg.session,
     };
     let start_time = Instant::now();
     let result = (|| {
@@ -431,6 +477,8 @@ fn session(
                 },
                 1,
             )?;
+            // One clock for the start to pass the input register (both sides).
+            ls.drive(&idle, 1)?;
             let per_tick = u64::from(spec.tick_div) + 1;
             let mut budget = (plan.ticks_total() + 2) * per_tick + 2;
             if let Some(after) = spec.stop_after {
@@ -453,18 +501,30 @@ fn session(
             played += 1;
             report.moves = played;
             bar.inc(1);
-            bar.set_message(format!("{} ticks", ls.ticks));
         }
         Ok(())
     })();
-    bar.finish_and_clear();
     report.seconds = start_time.elapsed().as_secs_f64();
     report.clocks = ls.clock;
     report.ticks = ls.ticks;
     result
 }
 
-/// Runs a co-simulation of `verilog` (the motion core) against the model.
+fn progress_bar(cfg: &CosimConfig) -> ProgressBar {
+    if cfg.progress && std::io::stderr().is_terminal() {
+        let b = ProgressBar::new(cfg.moves as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} moves {elapsed_precise}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    }
+}
+
+/// Runs a co-simulation of `verilog` (the motion core) against the model, in parallel
+/// sessions (see [`CosimConfig::sessions`]).
 pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
     let built = build(verilog, cfg.vcd.is_some())?;
     let window = cfg.vcd.as_ref().map(|p| VcdWindow {
@@ -472,14 +532,54 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
         from: 0,
         to: u64::MAX,
     });
-    let fabric = Fabric::open(&built.library, window.as_ref())?;
+    let sessions = cfg.sessions();
+    let mut fabrics = Vec::with_capacity(sessions.len());
+    for _ in &sessions {
+        fabrics.push(Fabric::open(&built.library, window.as_ref())?);
+    }
+    let bar = progress_bar(cfg);
+    let wall = Instant::now();
+    let results: Vec<(CosimReport, Result<(), Mismatch>)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = sessions
+            .iter()
+            .zip(fabrics)
+            .map(|(s, fab)| {
+                let bar = bar.clone();
+                scope.spawn(move || {
+                    let mut r = CosimReport::default();
+                    let res = session(s, Some(fab), &mut r, &bar);
+                    (r, res)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a co-simulation session panicked"))
+            .collect()
+    });
+    bar.finish_and_clear();
     let mut report = CosimReport {
         cached_build: built.cached,
         vcd: cfg.vcd.clone(),
+        seconds: wall.elapsed().as_secs_f64(),
         ..Default::default()
     };
-    if let Err(m) = session(cfg, Some(fabric), &mut report) {
-        // Re-run with a trace build and dump the clocks around the mismatch.
+    let mut first: Option<Mismatch> = None;
+    for (r, res) in results {
+        report.moves += r.moves;
+        report.stopped += r.stopped;
+        report.skipped += r.skipped;
+        report.clocks += r.clocks;
+        report.ticks += r.ticks;
+        report.planner_disagreements += r.planner_disagreements;
+        if let Err(m) = res {
+            if first.is_none() {
+                first = Some(m);
+            }
+        }
+    }
+    if let Some(m) = first {
+        // Re-run that session with a trace build and dump the clocks around the mismatch.
         if cfg.vcd.is_none() {
             let traced = build(verilog, true)?;
             let w = VcdWindow {
@@ -492,10 +592,11 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
             let _ = session(
                 &CosimConfig {
                     progress: false,
-                    ..cfg.clone()
+                    ..sessions[m.session].clone()
                 },
                 Some(fab),
                 &mut again,
+                &ProgressBar::hidden(),
             );
             report.vcd = Some(cfg.mismatch_vcd.clone());
         }
@@ -504,18 +605,28 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
     Ok(report)
 }
 
-/// Runs the same session on the model alone (no fabric): the reference for the co-sim/model
-/// throughput ratio.
+/// Runs the same sessions one after the other on the model alone (no fabric): the reference
+/// for the co-sim/model throughput ratio (single-threaded; divide by the session count for a
+/// per-core comparison).
 pub fn run_model_only(cfg: &CosimConfig) -> CosimReport {
     let mut report = CosimReport::default();
-    let _ = session(
-        &CosimConfig {
-            progress: false,
-            fault: None,
-            ..cfg.clone()
-        },
-        None,
-        &mut report,
-    );
+    let wall = Instant::now();
+    for s in cfg.sessions() {
+        let mut r = CosimReport::default();
+        let _ = session(
+            &CosimConfig {
+                progress: false,
+                fault: None,
+                ..s
+            },
+            None,
+            &mut r,
+            &ProgressBar::hidden(),
+        );
+        report.moves += r.moves;
+        report.clocks += r.clocks;
+        report.ticks += r.ticks;
+    }
+    report.seconds = wall.elapsed().as_secs_f64();
     report
 }

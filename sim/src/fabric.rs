@@ -134,6 +134,33 @@ impl Drop for Fabric {
     }
 }
 
+/// Encodes outputs in the harness's word layout (the inverse of [`decode`]): comparing words
+/// is cheaper than decoding the fabric's.
+#[inline]
+pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
+    let mut w = [0u32; OUT_WORDS];
+    let mut wide = |k: usize, v: i128, bits: u32| {
+        let u = (v as u128) & (u128::MAX >> (128 - bits));
+        w[k] = u as u32;
+        w[k + 1] = (u >> 32) as u32;
+        w[k + 2] = (u >> 64) as u32;
+        w[k + 3] = (u >> 96) as u32;
+    };
+    wide(0, o.x, f.widths.x);
+    wide(4, o.v, f.widths.v);
+    wide(8, o.a, f.widths.a);
+    wide(12, o.j, f.widths.j);
+    w[16] = o.position;
+    w[17] = u32::from(o.segment)
+        | u32::from(o.busy) << 8
+        | u32::from(o.done) << 9
+        | u32::from(o.aborted) << 10
+        | u32::from(o.tick) << 11
+        | u32::from(o.active_bank) << 12;
+    w[18] = o.tick_count;
+    w
+}
+
 /// Decodes one clock's output words.
 #[inline]
 pub fn decode(w: &[u32], f: &Format) -> CoreOutputs {

@@ -3,6 +3,8 @@
 //! the clock-accurate model (`snapgen_model::CoreModel`); every output is compared on every
 //! clock.
 //!
+//! * [`wrapper`] puts a register on every input of the core, so Verilator evaluates its logic
+//!   once per clock instead of twice (co-simulation only).
 //! * [`build`] runs Verilator (cached by a hash of everything that goes into the build).
 //! * [`fabric`] loads the library and drives it.
 //! * [`cosim`] runs both in lockstep and reports the first mismatch.
@@ -12,6 +14,7 @@ pub mod build;
 pub mod cosim;
 pub mod fabric;
 pub mod moves;
+pub mod wrapper;
 
 use std::path::PathBuf;
 
