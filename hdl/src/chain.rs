@@ -106,6 +106,8 @@ mod tests {
     fn snap_chain_is_synthesizable() {
         let mut uut = SnapChain::default();
         uut.connect_all();
-        yosys_validate("snap_chain", &generate_verilog(&uut)).unwrap();
+        let v = generate_verilog(&uut);
+        yosys_validate("snap_chain", &v).unwrap();
+        crate::synth_check::synth_xilinx("snap_chain", &v);
     }
 }

@@ -201,6 +201,8 @@ mod tests {
     fn motion_core_is_synthesizable() {
         let mut uut = MotionCore::default();
         uut.connect_all();
-        yosys_validate("motion_core", &generate_verilog(&uut)).unwrap();
+        let v = generate_verilog(&uut);
+        yosys_validate("motion_core", &v).unwrap();
+        crate::synth_check::synth_xilinx("motion_core", &v);
     }
 }

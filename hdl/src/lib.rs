@@ -63,3 +63,44 @@ const _: () = {
     );
     assert!(X_BITS > V_BITS && X_BITS <= 127 && X_BITS >= FRAC + POSITION_BITS);
 };
+
+/// Test support: real synthesis of a block with Yosys `synth_xilinx` (rust-hdl's
+/// `yosys_validate` only parses).
+#[cfg(test)]
+pub(crate) mod synth_check {
+    use std::process::Command;
+
+    /// Synthesises `verilog` (top module `top`) for the 7 series; panics on a Yosys error or
+    /// on any latch. Returns the `stat` text.
+    pub fn synth_xilinx(name: &str, verilog: &str) -> String {
+        let dir = std::env::temp_dir().join(format!("snapgen-synth-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("top.v");
+        std::fs::write(&file, verilog).unwrap();
+        let out = Command::new("yosys")
+            .args(["-q", "-p"])
+            .arg(format!(
+                "read_verilog {}; synth_xilinx -family xc7 -top top -flatten -noiopad; tee -q -o /dev/stdout stat",
+                file.display()
+            ))
+            .output()
+            .expect("yosys is installed by the test command (scripts/test.sh)");
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        assert!(
+            out.status.success(),
+            "{name}: yosys failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for latch in ["LDCE", "LDPE", "$_DLATCH"] {
+            assert!(
+                !text.contains(latch),
+                "{name}: synthesised with a latch:\n{text}"
+            );
+        }
+        assert!(
+            text.contains("Number of cells"),
+            "{name}: no statistics:\n{text}"
+        );
+        text
+    }
+}

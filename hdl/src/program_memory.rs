@@ -101,6 +101,10 @@ mod tests {
     fn program_memory_is_synthesizable() {
         let mut uut = ProgramMemory::default();
         uut.connect_all();
-        yosys_validate("program_memory", &generate_verilog(&uut)).unwrap();
+        let v = generate_verilog(&uut);
+        yosys_validate("program_memory", &v).unwrap();
+        let stat = crate::synth_check::synth_xilinx("program_memory", &v);
+        // Asynchronous read: distributed (LUT) RAM, no block RAM.
+        assert!(stat.contains("RAM64M") && !stat.contains("RAMB"), "{stat}");
     }
 }

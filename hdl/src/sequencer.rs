@@ -169,6 +169,8 @@ mod tests {
     fn sequencer_is_synthesizable() {
         let mut uut = Sequencer::default();
         uut.connect_all();
-        yosys_validate("sequencer", &generate_verilog(&uut)).unwrap();
+        let v = generate_verilog(&uut);
+        yosys_validate("sequencer", &v).unwrap();
+        crate::synth_check::synth_xilinx("sequencer", &v);
     }
 }

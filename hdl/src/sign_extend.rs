@@ -49,6 +49,8 @@ mod tests {
     fn sign_extend_is_synthesizable() {
         let mut uut = SignExtend::default();
         uut.connect_all();
-        yosys_validate("sign_extend", &generate_verilog(&uut)).unwrap();
+        let v = generate_verilog(&uut);
+        yosys_validate("sign_extend", &v).unwrap();
+        crate::synth_check::synth_xilinx("sign_extend", &v);
     }
 }
