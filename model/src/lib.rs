@@ -16,6 +16,7 @@ pub mod format;
 pub mod peaks;
 pub mod planner;
 pub mod program;
+pub mod protocol;
 
 pub use chain::{ChainState, Sequencer, TickSample, Trace};
 pub use core::{CoreInputs, CoreModel, CoreOutputs};
