@@ -582,6 +582,73 @@ mod tests {
             .to_bytes()),
             "A5 05 08 0A 01 E1 04 00 00 E0 E8"
         );
+        assert_eq!(
+            hex(&Command::Stop.to_frame(0x0C, &f).to_bytes()),
+            "A5 00 05 0C E5 F2"
+        );
+        assert_eq!(
+            hex(&Command::Abort.to_frame(0x0D, &f).to_bytes()),
+            "A5 00 06 0D 97 B7"
+        );
+        assert_eq!(
+            hex(&Command::ReadStatus.to_frame(0x0B, &f).to_bytes()),
+            "A5 00 07 0B 60 E4"
+        );
+        assert_eq!(
+            hex(&Reply::Version {
+                protocol: 1,
+                max_segments: 32,
+                snap_bytes: 13
+            }
+            .to_frame(0x01)
+            .to_bytes()),
+            "A5 03 41 01 01 20 0D 06 ED"
+        );
+        let status = Status {
+            state: 0b0010,
+            errors: 0,
+            tick_count: 85_000,
+            position: 500_000,
+            velocity: 0,
+            encoder: 500_000,
+            bad_crc: 0,
+            bad_frames: 1,
+        };
+        assert_eq!(
+            hex(&Reply::Status(status).to_frame(0x0B).to_bytes()),
+            "A5 16 47 0B 02 00 08 4C 01 00 20 A1 07 00 00 00 00 00 20 A1 07 00 00 00 01 00 2D 10"
+        );
+        let telemetry = Status {
+            state: 0b0001,
+            errors: 0,
+            tick_count: 40_000,
+            position: 235_702,
+            velocity: 123_456,
+            encoder: 235_700,
+            bad_crc: 0,
+            bad_frames: 0,
+        };
+        assert_eq!(
+            hex(&Reply::Telemetry(telemetry).to_frame(0x00).to_bytes()),
+            "A5 16 80 00 01 00 40 9C 00 00 B6 98 03 00 40 E2 01 00 B4 98 03 00 00 00 00 00 A0 85"
+        );
+        assert_eq!(
+            hex(&Reply::Ack {
+                cmd: code::LOAD_SEGMENT
+            }
+            .to_frame(0x07)
+            .to_bytes()),
+            "A5 01 7E 07 02 A8 88"
+        );
+        assert_eq!(
+            hex(&Reply::Nak {
+                cmd: 0,
+                reason: Reason::BadCrc
+            }
+            .to_frame(0x00)
+            .to_bytes()),
+            "A5 02 7F 00 00 01 35 D3"
+        );
     }
 
     #[test]
@@ -662,7 +729,9 @@ mod tests {
             payload,
         };
         assert_eq!(
-            Command::from_frame(&fr(0x55, vec![]), &f).unwrap_err().reason,
+            Command::from_frame(&fr(0x55, vec![]), &f)
+                .unwrap_err()
+                .reason,
             Reason::UnknownCommand
         );
         assert_eq!(

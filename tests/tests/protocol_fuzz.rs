@@ -6,7 +6,11 @@ use snapgen_model::protocol::{crc16, Command, Decoded, Decoder, Frame, Reply, ST
 use snapgen_model::DEFAULT_FORMAT;
 
 fn frame() -> impl Strategy<Value = Frame> {
-    (any::<u8>(), any::<u8>(), proptest::collection::vec(any::<u8>(), 0..40))
+    (
+        any::<u8>(),
+        any::<u8>(),
+        proptest::collection::vec(any::<u8>(), 0..40),
+    )
         .prop_map(|(cmd, seq, payload)| Frame { cmd, seq, payload })
 }
 
