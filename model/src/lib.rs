@@ -13,6 +13,7 @@ pub mod chain;
 pub mod core;
 pub mod error;
 pub mod format;
+pub mod io;
 pub mod peaks;
 pub mod planner;
 pub mod program;
