@@ -19,12 +19,18 @@
 //! * Its simulator is slow past 32 bits: the blocks' own tests are short; long runs use
 //!   Verilator (`snapgen-sim`).
 
+pub mod byte_fifo;
 pub mod chain;
 pub mod core;
+pub mod input_filter;
 pub mod program_memory;
+pub mod pwm;
+pub mod quadrature;
 pub mod sequencer;
 pub mod sign_extend;
 pub mod tick_divider;
+pub mod uart_rx;
+pub mod uart_tx;
 pub mod verilog;
 
 use snapgen_model::{DEFAULT_FORMAT, FRAC_BITS};

@@ -79,7 +79,12 @@ mod tests {
 
     #[test]
     fn duty_sets_the_high_time_and_saturates() {
-        for (duty, want_high, dir) in [(3i16, 3usize, false), (-7, 7, true), (50, 10, false), (0, 0, false)] {
+        for (duty, want_high, dir) in [
+            (3i16, 3usize, false),
+            (-7, 7, true),
+            (50, 10, false),
+            (0, 0, false),
+        ] {
             let mut p = Pwm::new();
             let i = PwmInputs {
                 period: 10,

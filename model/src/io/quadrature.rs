@@ -29,7 +29,7 @@ pub struct QuadOutputs {
     pub count: i32,
     /// Illegal transitions seen (wraps at 2^16).
     pub errors: u16,
-    /// The count latched at the last rising edge of the index.
+    /// The count latched at the last rising edge of the index (as it stood before that clock).
     pub index_count: i32,
     /// An index edge was seen since the last clear.
     pub index_seen: bool,
@@ -73,15 +73,16 @@ impl Quadrature {
         if i.clear {
             *o = QuadOutputs::default();
         } else {
+            // The index latches the count as it stood before this clock's step.
+            if self.z.level && !self.prev_z {
+                o.index_count = o.count;
+                o.index_seen = true;
+            }
             match new.wrapping_sub(old) & 3 {
                 1 => o.count = o.count.wrapping_add(1),
                 3 => o.count = o.count.wrapping_sub(1),
                 2 => o.errors = o.errors.wrapping_add(1),
                 _ => {}
-            }
-            if self.z.level && !self.prev_z {
-                o.index_count = o.count;
-                o.index_seen = true;
             }
         }
         self.prev_a = self.a.level;

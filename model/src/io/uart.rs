@@ -168,6 +168,11 @@ impl UartTx {
         Self::default()
     }
 
+    /// True while a byte is being sent.
+    pub fn busy(&self) -> bool {
+        self.busy
+    }
+
     /// One clock: `start` with `data` begins a byte when idle.
     #[inline]
     pub fn clock(&mut self, start: bool, data: u8, divisor: u16) -> TxOutputs {
