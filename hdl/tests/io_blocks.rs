@@ -73,7 +73,7 @@ fn encoder_stimulus(seed: u64, clocks: usize) -> Vec<QuadInputs> {
                 clear: false,
             };
             // Glitches shorter and longer than the filter.
-            if roll >= 85 && roll < 95 && k < 1 + r.below(6) as usize {
+            if (85..95).contains(&roll) && k < 1 + r.below(6) as usize {
                 i.a = !i.a;
             }
             if roll >= 95 && r.chance(30) {
