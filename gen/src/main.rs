@@ -5,10 +5,12 @@
 //! planned; the message says what to change).
 
 mod args;
+mod board;
 mod demo;
 mod hw;
 mod plot;
 mod report;
+mod send;
 mod trace;
 mod yosys;
 
@@ -90,6 +92,39 @@ enum Command {
         /// ("CLOCK:REGISTER:BIT"), to show that a one-bit difference is reported.
         #[arg(long, hide = true)]
         inject_fault: Option<String>,
+    },
+    /// Plan a move and run it on a board over a serial port: upload, start, follow, check.
+    Send {
+        /// Serial device (a real board's USB-UART, or the path `snapgen board --pty` prints).
+        #[arg(long)]
+        port: String,
+        /// Baud rate.
+        #[arg(long, default_value_t = 115_200)]
+        baud: u32,
+        /// Reply timeout per attempt, in milliseconds.
+        #[arg(long, default_value_t = 300)]
+        timeout_ms: u64,
+        /// Retries after a lost reply or a corrupted frame.
+        #[arg(long, default_value_t = 3)]
+        retries: u32,
+        /// Test hook: corrupt one bit of segment K's frame on every attempt.
+        #[arg(long, hide = true)]
+        corrupt_segment: Option<u8>,
+        #[command(flatten)]
+        plan: PlanArgs,
+    },
+    /// A virtual board behind a pseudo-terminal: prints its path, then serves the protocol on
+    /// the device model until stopped.
+    Board {
+        /// Open a pseudo-terminal (the only transport so far).
+        #[arg(long, required = true)]
+        pty: bool,
+        /// Simulated fabric clocks per second of wall time.
+        #[arg(long, default_value_t = 100_000)]
+        clocks_per_second: u64,
+        /// Initial tick divider (clocks per tick − 1).
+        #[arg(long, default_value_t = 0)]
+        tick_div: u32,
     },
     /// Print the fixed-point format: widths, range and resolution of every register.
     Format {
@@ -213,6 +248,45 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 return Err(anyhow::Error::new(Mismatched));
             }
         }
+        Command::Send {
+            port,
+            baud,
+            timeout_ms,
+            retries,
+            corrupt_segment,
+            plan,
+        } => {
+            let request = plan.request()?;
+            let format = plan.format();
+            let opts = send::SendOptions {
+                port,
+                baud,
+                timeout: std::time::Duration::from_millis(timeout_ms),
+                retries,
+                corrupt_segment,
+            };
+            let r = match send::send(&request, &format, &opts) {
+                Ok(r) => r,
+                Err(send::SendFailure::Plan(e)) => return Err(InputError::from(e).into()),
+                Err(send::SendFailure::Link(e)) => return Err(e.into()),
+            };
+            println!(
+                "moved {} units in {} ticks: now at {} LSB = {} units, encoder {} counts; the position register matches the plan bit for bit",
+                r.plan.request.distance,
+                r.status.tick_count,
+                r.status.position,
+                f64::from(r.status.position) * format.position_lsb,
+                r.status.encoder
+            );
+        }
+        Command::Board {
+            pty: _,
+            clocks_per_second,
+            tick_div,
+        } => board::run(board::BoardOptions {
+            clocks_per_second,
+            tick_div,
+        })?,
         Command::Demo { out } => demo::run(&out)?,
     }
     Ok(())

@@ -130,6 +130,11 @@ impl CoreModel {
         self.busy
     }
 
+    /// Segment count of the standby program (0: nothing to start).
+    pub fn standby_count(&self) -> u8 {
+        self.counts[usize::from(!self.bank)]
+    }
+
     /// One rising clock edge with inputs `i`; returns the outputs after it.
     #[inline]
     pub fn clock(&mut self, i: &CoreInputs) -> CoreOutputs {

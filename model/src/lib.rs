@@ -11,6 +11,7 @@
 
 pub mod chain;
 pub mod core;
+pub mod device;
 pub mod error;
 pub mod format;
 pub mod io;

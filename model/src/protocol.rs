@@ -22,6 +22,8 @@ pub const START: u8 = 0xA5;
 pub const OVERHEAD: usize = 6;
 /// Protocol version reported by `Ping`.
 pub const PROTOCOL_VERSION: u8 = 1;
+/// Bytes of the position register in a `POSITION` reply (112 bits).
+pub const POSITION_BYTES: usize = 14;
 
 /// CRC-16/CCITT-FALSE of `data`.
 pub fn crc16(data: &[u8]) -> u16 {
@@ -57,10 +59,14 @@ pub mod code {
     pub const READ_STATUS: u8 = 0x07;
     /// Set a configuration parameter.
     pub const CONFIGURE: u8 = 0x08;
+    /// Read the full position register; replied with `POSITION`.
+    pub const READ_POSITION: u8 = 0x09;
     /// Device → host: version (reply to `PING`).
     pub const VERSION: u8 = 0x41;
     /// Status (reply to `READ_STATUS`).
     pub const STATUS: u8 = 0x47;
+    /// Position register (reply to `READ_POSITION`).
+    pub const POSITION: u8 = 0x49;
     /// Acknowledge.
     pub const ACK: u8 = 0x7E;
     /// Reject with a reason.
@@ -164,6 +170,8 @@ pub enum Command {
         /// Value.
         value: u32,
     },
+    /// Read the position register.
+    ReadPosition,
 }
 
 /// Device state.
@@ -215,6 +223,11 @@ pub enum Reply {
     Status(Status),
     /// Telemetry.
     Telemetry(Status),
+    /// The position register (raw, `x_bits` wide, sign-extended).
+    Position {
+        /// Raw position register.
+        x: i128,
+    },
 }
 
 /// A frame: command code, sequence number, payload.
@@ -256,15 +269,43 @@ pub enum Decoded {
 /// Byte-at-a-time frame decoder: hunts for the start byte, reads the header and payload and
 /// checks the CRC. Never panics; on a bad CRC it resynchronises on the next start byte after
 /// the bad frame's first byte.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Decoder {
     buf: Vec<u8>,
+    max_payload: usize,
 }
 
+impl Default for Decoder {
+    fn default() -> Self {
+        Decoder {
+            buf: Vec::new(),
+            max_payload: 255,
+        }
+    }
+}
+
+/// The longest payload a device accepts: a longer `LEN` cannot start a frame, so its start byte
+/// is taken as noise at once (a corrupted frame's payload byte 0xA5 then cannot swallow the
+/// frames that follow for long).
+pub const DEVICE_MAX_PAYLOAD: usize = 32;
+
 impl Decoder {
-    /// A decoder waiting for a start byte.
+    /// A decoder waiting for a start byte, accepting any payload length.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A decoder that takes a start byte followed by a length above `max` as noise.
+    pub fn with_max_payload(max: usize) -> Self {
+        Decoder {
+            buf: Vec::new(),
+            max_payload: max,
+        }
+    }
+
+    /// True when no partial frame is held.
+    pub fn is_idle(&self) -> bool {
+        self.buf.is_empty()
     }
 
     /// Drops a partial frame (after an inter-byte timeout or a UART framing error).
@@ -280,6 +321,11 @@ impl Decoder {
             return None;
         }
         self.buf.push(b);
+        if self.buf.len() == 2 && usize::from(b) > self.max_payload {
+            // Not a frame start: rescan from the length byte.
+            self.buf.clear();
+            return self.push(b);
+        }
         if self.buf.len() < 4 {
             return None;
         }
@@ -336,6 +382,7 @@ impl Command {
             Command::Abort => code::ABORT,
             Command::ReadStatus => code::READ_STATUS,
             Command::Configure { .. } => code::CONFIGURE,
+            Command::ReadPosition => code::READ_POSITION,
         }
     }
 
@@ -431,6 +478,10 @@ impl Command {
                 need(0)?;
                 Command::ReadStatus
             }
+            code::READ_POSITION => {
+                need(0)?;
+                Command::ReadPosition
+            }
             code::CONFIGURE => {
                 need(5)?;
                 let param = Param::from_byte(p[0]).ok_or(reject(Reason::BadArgument))?;
@@ -490,6 +541,7 @@ impl Reply {
             Reply::Nak { cmd, reason } => (code::NAK, vec![cmd, reason as u8]),
             Reply::Status(s) => (code::STATUS, s.to_payload()),
             Reply::Telemetry(s) => (code::TELEMETRY, s.to_payload()),
+            Reply::Position { x } => (code::POSITION, x.to_le_bytes()[..POSITION_BYTES].to_vec()),
         };
         Frame { cmd, seq, payload }
     }
@@ -510,6 +562,16 @@ impl Reply {
             },
             (code::STATUS, _) => Reply::Status(Status::from_payload(p)?),
             (code::TELEMETRY, _) => Reply::Telemetry(Status::from_payload(p)?),
+            (code::POSITION, POSITION_BYTES) => {
+                let mut wide = [0u8; 16];
+                wide[..POSITION_BYTES].copy_from_slice(p);
+                if p[POSITION_BYTES - 1] & 0x80 != 0 {
+                    wide[POSITION_BYTES..].fill(0xff);
+                }
+                Reply::Position {
+                    x: i128::from_le_bytes(wide),
+                }
+            }
             _ => return None,
         })
     }
@@ -633,6 +695,18 @@ mod tests {
             "A5 16 80 00 01 00 40 9C 00 00 B6 98 03 00 40 E2 01 00 B4 98 03 00 00 00 00 00 A0 85"
         );
         assert_eq!(
+            hex(&Command::ReadPosition.to_frame(0x0E, &f).to_bytes()),
+            "A5 00 09 0E CA 97"
+        );
+        assert_eq!(
+            hex(&Reply::Position {
+                x: (500_000i128 << 80) + (1i128 << 79)
+            }
+            .to_frame(0x0E)
+            .to_bytes()),
+            "A5 0E 49 0E 00 00 00 00 00 00 00 00 00 80 20 A1 07 00 B2 E0"
+        );
+        assert_eq!(
             hex(&Reply::Ack {
                 cmd: code::LOAD_SEGMENT
             }
@@ -672,6 +746,7 @@ mod tests {
                 param: Param::TelemetryPeriod,
                 value: 100,
             },
+            Command::ReadPosition,
         ] {
             let bytes = c.to_frame(200, &f).to_bytes();
             let mut d = Decoder::new();
@@ -714,6 +789,12 @@ mod tests {
             },
             Reply::Status(s),
             Reply::Telemetry(s),
+            Reply::Position {
+                x: -(1i128 << 100) + 7,
+            },
+            Reply::Position {
+                x: (1i128 << 110) - 1,
+            },
         ] {
             let f = r.to_frame(3);
             assert_eq!(Reply::from_frame(&f), Some(r));

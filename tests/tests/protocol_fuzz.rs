@@ -2,7 +2,9 @@
 //! accepted. Raise the case count with `PROPTEST_CASES`.
 
 use proptest::prelude::*;
-use snapgen_model::protocol::{crc16, Command, Decoded, Decoder, Frame, Reply, START};
+use snapgen_model::protocol::{
+    crc16, Command, Decoded, Decoder, Frame, Reply, DEVICE_MAX_PAYLOAD, START,
+};
 use snapgen_model::DEFAULT_FORMAT;
 
 fn frame() -> impl Strategy<Value = Frame> {
@@ -19,12 +21,18 @@ fn decode_all(bytes: &[u8]) -> Vec<Decoded> {
     bytes.iter().filter_map(|&b| d.push(b)).collect()
 }
 
+/// As a device decodes: lengths above `DEVICE_MAX_PAYLOAD` are not frame starts.
+fn device_decode_all(bytes: &[u8]) -> Vec<Decoded> {
+    let mut d = Decoder::with_max_payload(DEVICE_MAX_PAYLOAD);
+    bytes.iter().filter_map(|&b| d.push(b)).collect()
+}
+
 proptest! {
     /// Any byte stream: no panic; every frame the decoder accepts carries a matching CRC, and
     /// parsing it as a command or a reply never panics.
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
-        for d in decode_all(&bytes) {
+        for d in decode_all(&bytes).into_iter().chain(device_decode_all(&bytes)) {
             if let Decoded::Frame(f) = d {
                 let wire = f.to_bytes();
                 let n = wire.len();
@@ -41,7 +49,10 @@ proptest! {
         let mut bytes = pre;
         bytes.extend(f.to_bytes());
         let got = decode_all(&bytes);
-        prop_assert_eq!(got.last(), Some(&Decoded::Frame(f)));
+        prop_assert_eq!(got.last(), Some(&Decoded::Frame(f.clone())));
+        if f.payload.len() <= DEVICE_MAX_PAYLOAD {
+            prop_assert_eq!(device_decode_all(&bytes).last(), Some(&Decoded::Frame(f)));
+        }
     }
 
     /// One to three flipped bits anywhere after the length byte are always detected
@@ -58,7 +69,7 @@ proptest! {
             }
         }
         prop_assume!(!seen.is_empty());
-        for d in decode_all(&bytes) {
+        for d in decode_all(&bytes).into_iter().chain(device_decode_all(&bytes)) {
             if let Decoded::Frame(g) = d {
                 prop_assert!(false, "a corrupt frame decoded as {:?}", g);
             }
