@@ -55,7 +55,7 @@ impl Device {
         Device {
             format: *format,
             core,
-            decoder: Decoder::with_max_payload(crate::protocol::DEVICE_MAX_PAYLOAD),
+            decoder: Decoder::device(),
             config,
             bad_crc: 0,
             bad_frames: 0,
@@ -151,7 +151,8 @@ impl Device {
     }
 
     fn execute(&mut self, f: &Frame) {
-        // A retry of the last frame: answer again, do not execute again.
+        // A retry of the last command with an effect: answer again, do not execute again.
+        // (Reads and pings simply run again.)
         if let Some((cmd, seq, bytes)) = &self.last {
             if *cmd == f.cmd && *seq == f.seq {
                 let bytes = bytes.clone();
@@ -172,7 +173,12 @@ impl Device {
             Ok(c) => self.command(c),
         };
         let bytes = self.send(reply, f.seq);
-        self.last = Some((f.cmd, f.seq, bytes));
+        if matches!(
+            f.cmd,
+            code::LOAD_SEGMENT | code::COMMIT | code::START | code::ABORT | code::CONFIGURE
+        ) {
+            self.last = Some((f.cmd, f.seq, bytes));
+        }
     }
 
     fn command(&mut self, c: Command) -> Reply {

@@ -273,6 +273,7 @@ pub enum Decoded {
 pub struct Decoder {
     buf: Vec<u8>,
     max_payload: usize,
+    rescan: bool,
 }
 
 impl Default for Decoder {
@@ -280,6 +281,7 @@ impl Default for Decoder {
         Decoder {
             buf: Vec::new(),
             max_payload: 255,
+            rescan: true,
         }
     }
 }
@@ -300,6 +302,18 @@ impl Decoder {
         Decoder {
             buf: Vec::new(),
             max_payload: max,
+            rescan: true,
+        }
+    }
+
+    /// The device's decoder, as the fabric implements it: lengths above
+    /// [`DEVICE_MAX_PAYLOAD`] are noise, and after a bad CRC it hunts for the next start byte
+    /// among the bytes still to come (it keeps no bytes to rescan).
+    pub fn device() -> Self {
+        Decoder {
+            buf: Vec::new(),
+            max_payload: DEVICE_MAX_PAYLOAD,
+            rescan: false,
         }
     }
 
@@ -344,6 +358,10 @@ impl Decoder {
             self.buf.clear();
             Some(Decoded::Frame(f))
         } else {
+            if !self.rescan {
+                self.buf.clear();
+                return Some(Decoded::BadCrc);
+            }
             // Resynchronise: rescan what followed the bad frame's start byte.
             let rest: Vec<u8> = self.buf[1..].to_vec();
             self.buf.clear();

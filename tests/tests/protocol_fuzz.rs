@@ -23,7 +23,7 @@ fn decode_all(bytes: &[u8]) -> Vec<Decoded> {
 
 /// As a device decodes: lengths above `DEVICE_MAX_PAYLOAD` are not frame starts.
 fn device_decode_all(bytes: &[u8]) -> Vec<Decoded> {
-    let mut d = Decoder::with_max_payload(DEVICE_MAX_PAYLOAD);
+    let mut d = Decoder::device();
     bytes.iter().filter_map(|&b| d.push(b)).collect()
 }
 
