@@ -22,7 +22,10 @@
 pub mod byte_fifo;
 pub mod chain;
 pub mod core;
+pub mod frame_rx;
+pub mod crc16;
 pub mod input_filter;
+pub mod payload_shift;
 pub mod program_memory;
 pub mod pwm;
 pub mod quadrature;
