@@ -22,6 +22,7 @@
 pub mod byte_fifo;
 pub mod chain;
 pub mod core;
+pub mod executor;
 pub mod frame_rx;
 pub mod crc16;
 pub mod input_filter;
@@ -29,6 +30,8 @@ pub mod payload_shift;
 pub mod program_memory;
 pub mod pwm;
 pub mod quadrature;
+pub mod reply_packer;
+pub mod reply_tx;
 pub mod sequencer;
 pub mod sign_extend;
 pub mod tick_divider;
