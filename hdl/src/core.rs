@@ -68,6 +68,8 @@ pub struct MotionCore {
     pub tick: Signal<Out, Bit>,
     /// Bank that plays (the other one is written).
     pub active_bank: Signal<Out, Bit>,
+    /// Segment count of the standby program (0: nothing to start).
+    pub standby_count: Signal<Out, Bits<INDEX_BITS>>,
     divider: TickDivider,
     memory: ProgramMemory,
     sequencer: Sequencer,
@@ -106,6 +108,7 @@ impl Default for MotionCore {
             tick_count: Default::default(),
             tick: Default::default(),
             active_bank: Default::default(),
+            standby_count: Default::default(),
             divider: Default::default(),
             memory: Default::default(),
             sequencer: Default::default(),
@@ -190,6 +193,11 @@ impl Logic for MotionCore {
         self.tick_count.next = self.sequencer.tick_count.val();
         self.tick.next = self.divider.tick.val();
         self.active_bank.next = self.bank.q.val();
+        if self.bank.q.val() {
+            self.standby_count.next = self.count0.q.val();
+        } else {
+            self.standby_count.next = self.count1.q.val();
+        }
     }
 }
 

@@ -20,7 +20,11 @@ pub struct Crc16Step {
 pub fn crc16_step(crc: u16, b: u8) -> u16 {
     let mut x = crc ^ (u16::from(b) << 8);
     for _ in 0..8 {
-        x = if x & 0x8000 != 0 { (x << 1) ^ 0x1021 } else { x << 1 };
+        x = if x & 0x8000 != 0 {
+            (x << 1) ^ 0x1021
+        } else {
+            x << 1
+        };
     }
     x
 }
@@ -45,12 +49,12 @@ function [15:0] crc16_step;
    input [15:0] c;
    input [7:0] b;
    integer i;
-   reg [15:0] x;
+   reg [15:0] acc;
    begin
-      x = c ^ {b, 8'h00};
+      acc = c ^ {b, 8'h00};
       for (i = 0; i < 8; i = i + 1)
-         x = x[15] ? ((x << 1) ^ 16'h1021) : (x << 1);
-      crc16_step = x;
+         acc = acc[15] ? ((acc << 1) ^ 16'h1021) : (acc << 1);
+      crc16_step = acc;
    end
 endfunction
 always @(*) crc_out = crc16_step(crc_in, data);

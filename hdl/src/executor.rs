@@ -341,7 +341,8 @@ impl Logic for Executor {
             }
         } else if self.cmd.val() == self.c_load.val() {
             if self.len.val() == self.b18.val() {
-                if (self.seg_index.val() < self.b32.val()) & (self.seg_ticks.val() != self.t0.val()) {
+                if (self.seg_index.val() < self.b32.val()) & (self.seg_ticks.val() != self.t0.val())
+                {
                     self.kind.next = self.k_ack.val();
                 } else {
                     self.reason.next = self.r_bad_argument.val();
@@ -403,7 +404,8 @@ impl Logic for Executor {
             }
         } else if self.cmd.val() == self.c_config.val() {
             if self.len.val() == self.b5.val() {
-                if (self.cfg_param.val() >= self.b1.val()) & (self.cfg_param.val() <= self.b4.val()) {
+                if (self.cfg_param.val() >= self.b1.val()) & (self.cfg_param.val() <= self.b4.val())
+                {
                     self.kind.next = self.k_ack.val();
                 } else {
                     self.reason.next = self.r_bad_argument.val();

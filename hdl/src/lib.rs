@@ -22,10 +22,11 @@
 pub mod byte_fifo;
 pub mod chain;
 pub mod core;
+pub mod crc16;
 pub mod executor;
 pub mod frame_rx;
-pub mod crc16;
 pub mod input_filter;
+pub mod io_top;
 pub mod payload_shift;
 pub mod program_memory;
 pub mod pwm;

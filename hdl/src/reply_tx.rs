@@ -75,7 +75,7 @@ pub struct ReplyTx {
     sel_reason: Signal<Local, Bits<8>>,
     sel_seq: Signal<Local, Bits<8>>,
     launch: Signal<Local, Bit>,
-    byte: Signal<Local, Bits<8>>,
+    out_byte: Signal<Local, Bits<8>>,
     start_byte: Constant<Bits<8>>,
     one: Constant<Bits<8>>,
     four: Constant<Bits<8>>,
@@ -129,7 +129,7 @@ impl Default for ReplyTx {
             sel_reason: Default::default(),
             sel_seq: Default::default(),
             launch: Default::default(),
-            byte: Default::default(),
+            out_byte: Default::default(),
             start_byte: Constant::new(0xA5.into()),
             one: Constant::new(1.into()),
             four: Constant::new(4.into()),
@@ -196,24 +196,24 @@ impl Logic for ReplyTx {
         self.packer.x.next = self.x.val();
         // The byte at `index`: start, length, code, sequence, payload, CRC low, CRC high.
         if self.index.q.val() == self.zero8.val() {
-            self.byte.next = self.start_byte.val();
+            self.out_byte.next = self.start_byte.val();
         } else if self.index.q.val() == self.one.val() {
-            self.byte.next = self.len.q.val();
+            self.out_byte.next = self.len.q.val();
         } else if self.index.q.val() == (self.one.val() + self.one.val()) {
-            self.byte.next = self.code.q.val();
+            self.out_byte.next = self.code.q.val();
         } else if self.index.q.val() == (self.four.val() - self.one.val()) {
-            self.byte.next = self.seq_reg.q.val();
+            self.out_byte.next = self.seq_reg.q.val();
         } else if self.index.q.val() < (self.len.q.val() + self.four.val()) {
-            self.byte.next = self.payload.q.val().get_bits::<8>(0);
+            self.out_byte.next = self.payload.q.val().get_bits::<8>(0);
         } else if self.index.q.val() == (self.len.q.val() + self.four.val()) {
-            self.byte.next = self.crc.q.val().get_bits::<8>(0);
+            self.out_byte.next = self.crc.q.val().get_bits::<8>(0);
         } else {
-            self.byte.next = self.crc.q.val().get_bits::<8>(8);
+            self.out_byte.next = self.crc.q.val().get_bits::<8>(8);
         }
         self.step.crc_in.next = self.crc.q.val();
-        self.step.data.next = self.byte.val();
+        self.step.data.next = self.out_byte.val();
         self.fifo_write.next = false;
-        self.fifo_data.next = self.byte.val();
+        self.fifo_data.next = self.out_byte.val();
         if self.reset.val() {
             self.active.d.next = false;
             self.pending.d.next = false;
@@ -241,7 +241,9 @@ impl Logic for ReplyTx {
                 self.p_seq.d.next = self.seq.val();
                 self.p_reason.d.next = self.reason.val();
             }
-            if self.telemetry.val() & !(self.launch.val() & (self.sel_kind.val() == self.tel_kind.val())) {
+            if self.telemetry.val()
+                & !(self.launch.val() & (self.sel_kind.val() == self.tel_kind.val()))
+            {
                 self.tel_pending.d.next = true;
             }
             if self.active.q.val() & !self.fifo_full.val() {

@@ -128,6 +128,12 @@ fn rust_hdl_core_matches_the_model_clock_by_clock() {
                 sim_assert_eq!(sim, x.tick_count.val().to_u64() as u32, m.tick_count, x);
                 sim_assert_eq!(sim, x.tick.val(), m.tick, x);
                 sim_assert_eq!(sim, x.active_bank.val(), m.active_bank, x);
+                sim_assert_eq!(
+                    sim,
+                    x.standby_count.val().to_u64() as u8,
+                    m.standby_count,
+                    x
+                );
             }
         }
         // The program ran: the second one was stopped, the first completed and moved.

@@ -12,7 +12,12 @@ const TIMEOUT: u64 = 20;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 enum Event {
-    Frame { cmd: u8, seq: u8, len: u8, fields: Vec<u128> },
+    Frame {
+        cmd: u8,
+        seq: u8,
+        len: u8,
+        fields: Vec<u128>,
+    },
     BadCrc,
     Dropped,
 }
@@ -120,7 +125,12 @@ fn stimulus(seed: u64) -> (Vec<(u8, u64)>, Vec<Event>) {
 #[test]
 fn frame_receiver_matches_the_device_decoder() {
     let (bytes, want) = stimulus(0xF00D);
-    assert!(want.iter().filter(|e| matches!(e, Event::Frame { .. })).count() > 100);
+    assert!(
+        want.iter()
+            .filter(|e| matches!(e, Event::Frame { .. }))
+            .count()
+            > 100
+    );
     assert!(want.contains(&Event::BadCrc) && want.contains(&Event::Dropped));
     let mut sim = Simulation::new();
     sim.add_clock(5, |x: &mut Box<FrameRx>| x.clock.next = !x.clock.val());

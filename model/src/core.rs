@@ -73,6 +73,8 @@ pub struct CoreOutputs {
     pub tick: bool,
     /// Bank playing.
     pub active_bank: bool,
+    /// Segment count of the standby program.
+    pub standby_count: u8,
 }
 
 /// The clock-accurate core model.
@@ -260,6 +262,7 @@ impl CoreModel {
             tick_count: self.tick_count,
             tick: self.divider >= self.tick_div,
             active_bank: self.bank,
+            standby_count: self.counts[usize::from(!self.bank)],
         }
     }
 }

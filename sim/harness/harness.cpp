@@ -123,7 +123,8 @@ void snapgen_core_run(void* h, uint64_t n, uint32_t* out) {
         o[OUT_POSITION] = t->position;
         o[OUT_FLAGS] = (uint32_t)t->segment | ((uint32_t)t->busy << 8) |
                        ((uint32_t)t->done << 9) | ((uint32_t)t->aborted << 10) |
-                       ((uint32_t)t->tick << 11) | ((uint32_t)t->active_bank << 12);
+                       ((uint32_t)t->tick << 11) | ((uint32_t)t->active_bank << 12) |
+                       ((uint32_t)t->standby_count << 16);
         o[OUT_TICK_COUNT] = t->tick_count;
         t->clock = 0;
         Vtop___024root___eval(t->rootp);

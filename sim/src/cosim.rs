@@ -51,11 +51,13 @@ pub enum Register {
     Tick,
     /// Active bank.
     ActiveBank,
+    /// Standby program's segment count.
+    StandbyCount,
 }
 
 impl Register {
     /// Every register, in comparison order.
-    pub const ALL: [Register; 12] = [
+    pub const ALL: [Register; 13] = [
         Register::X,
         Register::V,
         Register::A,
@@ -68,6 +70,7 @@ impl Register {
         Register::TickCount,
         Register::Tick,
         Register::ActiveBank,
+        Register::StandbyCount,
     ];
 
     /// Its name (as the Verilog port).
@@ -85,6 +88,7 @@ impl Register {
             Register::TickCount => "tick_count",
             Register::Tick => "tick",
             Register::ActiveBank => "active_bank",
+            Register::StandbyCount => "standby_count",
         }
     }
 
@@ -96,7 +100,7 @@ impl Register {
             Register::A => f.widths.a,
             Register::J => f.widths.j,
             Register::Position | Register::TickCount => 32,
-            Register::Segment => 6,
+            Register::Segment | Register::StandbyCount => 6,
             _ => 1,
         }
     }
@@ -117,6 +121,7 @@ impl Register {
             Register::TickCount => u128::from(o.tick_count),
             Register::Tick => u128::from(o.tick),
             Register::ActiveBank => u128::from(o.active_bank),
+            Register::StandbyCount => u128::from(o.standby_count),
         }
     }
 
@@ -139,6 +144,7 @@ impl Register {
             Register::TickCount => o.tick_count ^= 1 << b,
             Register::Tick => o.tick = !o.tick,
             Register::ActiveBank => o.active_bank = !o.active_bank,
+            Register::StandbyCount => o.standby_count ^= 1 << b,
         }
     }
 }

@@ -156,7 +156,8 @@ pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
         | u32::from(o.done) << 9
         | u32::from(o.aborted) << 10
         | u32::from(o.tick) << 11
-        | u32::from(o.active_bank) << 12;
+        | u32::from(o.active_bank) << 12
+        | u32::from(o.standby_count) << 16;
     w[18] = o.tick_count;
     w
 }
@@ -184,6 +185,7 @@ pub fn decode(w: &[u32], f: &Format) -> CoreOutputs {
         aborted: flags >> 10 & 1 == 1,
         tick: flags >> 11 & 1 == 1,
         active_bank: flags >> 12 & 1 == 1,
+        standby_count: (flags >> 16 & 0x3f) as u8,
         tick_count: w[18],
     }
 }

@@ -44,7 +44,8 @@ module top(
     output wire aborted,
     output wire [{t}:0] tick_count,
     output wire tick,
-    output wire active_bank
+    output wire active_bank,
+    output wire [{ix}:0] standby_count
 );
     reg r_reset = 1'b0;
     reg [{t}:0] r_tick_div = {tb}'d0;
@@ -75,7 +76,7 @@ module top(
         .count_enable(r_count_enable), .count_value(r_count_value),
         .x(x), .v(v), .a(a), .j(j), .position(position), .segment(segment), .busy(busy),
         .done(done), .aborted(aborted), .tick_count(tick_count), .tick(tick),
-        .active_bank(active_bank)
+        .active_bank(active_bank), .standby_count(standby_count)
     );
 endmodule
 ",
