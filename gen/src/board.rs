@@ -1,10 +1,11 @@
 //! `snapgen board --pty`: a virtual board behind a pseudo-terminal.
 //!
-//! It serves `snapgen_model::device::Device` — the protocol executed on the clock-accurate core
-//! model — so that `snapgen send --port <path>` runs exactly as against a real board. The
-//! device clock runs at `--clocks-per-second` of wall time (default 100 000, with a tick on
-//! every clock: Ts = 10 µs in real time). The Verilated top-level core is not behind it yet:
-//! the fabric's command interface is not built.
+//! Behind it runs either the fabric — the Verilated I/O top (`--fabric`, the default): UART
+//! command interface, motion core, encoder decoder, PWM — or the device model
+//! (`snapgen_model::device::Device`, `--model`), so that `snapgen send --port <path>` runs
+//! exactly as against a real board. Simulated time runs at `--clocks-per-second` of wall time;
+//! the tick divider is set so that Ts = 10 µs in real time. The fabric's UART runs at 16 clocks
+//! per bit (the real board's top uses 1085 for 115 200 baud at 125 MHz).
 
 use std::io::Write;
 use std::os::fd::{AsFd, AsRawFd, OwnedFd};
@@ -28,8 +29,84 @@ const MAX_PENDING: usize = 64 * 1024;
 pub struct BoardOptions {
     /// Simulated fabric clocks per second of wall time.
     pub clocks_per_second: u64,
-    /// Initial tick divider.
-    pub tick_div: u32,
+    /// Run the Verilated I/O top (true) or the device model (false).
+    pub fabric: bool,
+}
+
+/// What serves the protocol.
+trait Target {
+    fn receive(&mut self, bytes: &[u8]);
+    fn run(&mut self, clocks: u64);
+    fn take_output(&mut self) -> Vec<u8>;
+    /// A partial frame is held (host-side inter-byte timeout for the model).
+    fn mid_frame(&self) -> bool;
+    fn timeout(&mut self);
+}
+
+impl Target for Device {
+    fn receive(&mut self, bytes: &[u8]) {
+        Device::receive(self, bytes)
+    }
+    fn run(&mut self, clocks: u64) {
+        Device::run(self, clocks)
+    }
+    fn take_output(&mut self) -> Vec<u8> {
+        Device::take_output(self)
+    }
+    fn mid_frame(&self) -> bool {
+        Device::mid_frame(self)
+    }
+    fn timeout(&mut self) {
+        Device::timeout(self)
+    }
+}
+
+impl Target for snapgen_sim::board::FabricBoard {
+    fn receive(&mut self, bytes: &[u8]) {
+        snapgen_sim::board::FabricBoard::receive(self, bytes)
+    }
+    fn run(&mut self, clocks: u64) {
+        snapgen_sim::board::FabricBoard::run(self, clocks)
+    }
+    fn take_output(&mut self) -> Vec<u8> {
+        snapgen_sim::board::FabricBoard::take_output(self)
+    }
+    // The fabric times out partial frames itself.
+    fn mid_frame(&self) -> bool {
+        false
+    }
+    fn timeout(&mut self) {}
+}
+
+/// UART clocks per bit of the virtual fabric board.
+const VIRTUAL_UART_DIVISOR: u16 = 16;
+
+fn target(opts: &BoardOptions) -> anyhow::Result<Box<dyn Target>> {
+    // Ts = 10 µs of wall time: clocks per tick = clocks_per_second / 100 000.
+    let tick_div = (opts.clocks_per_second / 100_000).max(1) as u32 - 1;
+    if !opts.fabric {
+        return Ok(Box::new(Device::new(
+            &DEFAULT_FORMAT,
+            DeviceConfig {
+                tick_div,
+                ..Default::default()
+            },
+        )));
+    }
+    let cfg = snapgen_hdl::io_top::IoTopConfig {
+        uart_divisor: VIRTUAL_UART_DIVISOR,
+        frame_timeout: (opts.clocks_per_second / 50) as u32,
+        tick_div,
+        heartbeat_bit: 20,
+    };
+    let verilog = snapgen_hdl::verilog::io_top_verilog(cfg);
+    let built = snapgen_sim::build::build_io(&verilog)?;
+    Ok(Box::new(snapgen_sim::board::FabricBoard::open(
+        &built.library,
+        snapgen_sim::board::FabricBoardConfig {
+            uart_divisor: VIRTUAL_UART_DIVISOR,
+        },
+    )?))
 }
 
 fn path_of(fd: &OwnedFd) -> anyhow::Result<String> {
@@ -48,19 +125,19 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
         tcsetattr(fd, SetArg::TCSANOW, &t).context("tcsetattr")?;
     }
     let path = path_of(&pty.slave)?;
-    println!("{path}");
-    std::io::stdout().flush()?;
+    let mut device = target(&opts)?;
     eprintln!(
-        "virtual board on {path}: device model at {} clocks/s (Ctrl-C to stop)",
+        "virtual board on {path}: {} at {} clocks/s (Ctrl-C to stop)",
+        if opts.fabric {
+            "Verilated I/O top"
+        } else {
+            "device model"
+        },
         opts.clocks_per_second
     );
-    let mut device = Device::new(
-        &DEFAULT_FORMAT,
-        DeviceConfig {
-            tick_div: opts.tick_div,
-            ..Default::default()
-        },
-    );
+    // The path goes out once the board is ready (the fabric may have needed a build).
+    println!("{path}");
+    std::io::stdout().flush()?;
     let master = pty.master;
     // Keep the slave open: the pty stays usable between clients.
     let _slave = pty.slave;
@@ -91,7 +168,7 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
                 Ok(n) if n > 0 => {
                     // A gap before these bytes ends a partial frame first.
                     if device.mid_frame() && last_byte.elapsed() > INTER_BYTE_TIMEOUT {
-                        device.line_error();
+                        device.timeout();
                     }
                     if debug {
                         eprintln!(
@@ -110,7 +187,7 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
         // Inter-byte timeout: a frame cut short is dropped (NAK FRAMING), so a corrupted
         // length byte cannot swallow the frames that follow.
         if device.mid_frame() && last_byte.elapsed() > INTER_BYTE_TIMEOUT {
-            device.line_error();
+            device.timeout();
         }
         let due = (start.elapsed().as_secs_f64() * opts.clocks_per_second as f64) as u64;
         if due > clocks_done {

@@ -7,22 +7,35 @@ use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
 
 /// Files `snapgen verilog` writes.
 pub struct VerilogFiles {
-    /// The core.
+    /// The motion core.
     pub verilog: PathBuf,
+    /// The I/O top (UART command interface, motion core, encoder, PWM) for 125 MHz.
+    pub io_top: PathBuf,
     /// The Verilator waiver file.
     pub waivers: PathBuf,
 }
 
-/// Writes the motion core's Verilog (`top.v`) and its Verilator waivers (`verilator.vlt`).
+/// Writes the motion core's Verilog (`top.v`), the I/O top (`io_top.v`) and their Verilator
+/// waivers (`verilator.vlt`).
 pub fn write_verilog(out: &Path) -> anyhow::Result<VerilogFiles> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let verilog = out.join("top.v");
+    let io_top = out.join("io_top.v");
     let waivers = out.join("verilator.vlt");
+    std::fs::write(
+        &io_top,
+        snapgen_hdl::verilog::io_top_verilog(snapgen_hdl::io_top::IoTopConfig::default()),
+    )
+    .with_context(|| format!("cannot write {}", io_top.display()))?;
     std::fs::write(&verilog, snapgen_hdl::verilog::motion_core_verilog())
         .with_context(|| format!("cannot write {}", verilog.display()))?;
     std::fs::write(&waivers, snapgen_sim::build::WAIVERS_VLT)
         .with_context(|| format!("cannot write {}", waivers.display()))?;
-    Ok(VerilogFiles { verilog, waivers })
+    Ok(VerilogFiles {
+        verilog,
+        io_top,
+        waivers,
+    })
 }
 
 /// Runs a co-simulation and prints its report; returns it.

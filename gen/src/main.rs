@@ -114,17 +114,17 @@ enum Command {
         plan: PlanArgs,
     },
     /// A virtual board behind a pseudo-terminal: prints its path, then serves the protocol on
-    /// the device model until stopped.
+    /// the Verilated I/O top (or, with --model, on the device model) until stopped.
     Board {
         /// Open a pseudo-terminal (the only transport so far).
         #[arg(long, required = true)]
         pty: bool,
-        /// Simulated fabric clocks per second of wall time.
-        #[arg(long, default_value_t = 100_000)]
-        clocks_per_second: u64,
-        /// Initial tick divider (clocks per tick − 1).
-        #[arg(long, default_value_t = 0)]
-        tick_div: u32,
+        /// Serve the device model instead of the Verilated fabric.
+        #[arg(long)]
+        model: bool,
+        /// Simulated fabric clocks per second of wall time (Ts stays 10 µs of wall time).
+        #[arg(long)]
+        clocks_per_second: Option<u64>,
     },
     /// Print the fixed-point format: widths, range and resolution of every register.
     Format {
@@ -224,8 +224,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Verilog { out } => {
             let files = hw::write_verilog(&out)?;
             println!(
-                "wrote {} and {}",
+                "wrote {}, {} and {}",
                 files.verilog.display(),
+                files.io_top.display(),
                 files.waivers.display()
             );
         }
@@ -271,21 +272,22 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 Err(send::SendFailure::Link(e)) => return Err(e.into()),
             };
             println!(
-                "moved {} units in {} ticks: now at {} LSB = {} units, encoder {} counts; the position register matches the plan bit for bit",
+                "moved {} units in {} ticks: now at {} LSB = {:.*} units, encoder {} counts; the position register matches the plan bit for bit",
                 r.plan.request.distance,
                 r.status.tick_count,
                 r.status.position,
+                (-format.position_lsb.log10()).ceil().max(0.0) as usize,
                 f64::from(r.status.position) * format.position_lsb,
                 r.status.encoder
             );
         }
         Command::Board {
             pty: _,
+            model,
             clocks_per_second,
-            tick_div,
         } => board::run(board::BoardOptions {
-            clocks_per_second,
-            tick_div,
+            clocks_per_second: clocks_per_second.unwrap_or(if model { 100_000 } else { 1_000_000 }),
+            fabric: !model,
         })?,
         Command::Demo { out } => demo::run(&out)?,
     }

@@ -405,9 +405,17 @@ pub fn send(
         false,
     )?;
     let x = link.position()?;
+    // Let the encoder settle on the final position (a real axis follows the reference with a
+    // lag), for up to a second.
+    let settle = Instant::now();
+    let mut last = link.status()?;
+    while last.encoder != last.position && settle.elapsed() < Duration::from_secs(1) {
+        std::thread::sleep(Duration::from_millis(20));
+        last = link.status()?;
+    }
     let status = Status {
         tick_count: status.tick_count,
-        ..link.status()?
+        ..last
     };
     if x != plan.final_state.x {
         return Err(SendError::WrongEnd {

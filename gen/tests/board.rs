@@ -14,9 +14,14 @@ struct Board {
 }
 
 impl Board {
-    fn start() -> Board {
+    /// A board serving the Verilated fabric (`fabric`) or the device model.
+    fn start_on(fabric: bool) -> Board {
+        let mut args = vec!["board", "--pty"];
+        if !fabric {
+            args.push("--model");
+        }
         let mut child = Command::new(env!("CARGO_BIN_EXE_snapgen"))
-            .args(["board", "--pty"])
+            .args(&args)
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
@@ -29,6 +34,10 @@ impl Board {
             child,
             port: line.trim().to_string(),
         }
+    }
+
+    fn start() -> Board {
+        Board::start_on(false)
     }
 
     /// A bare protocol client, independent of `snapgen send`.
@@ -90,7 +99,16 @@ const S_CURVE: [&str; 7] = ["--order", "3", "--vmax", "0.5", "--amax", "5", "--j
 
 #[test]
 fn positive_and_negative_moves_land_where_the_model_says() {
-    let board = Board::start();
+    moves_land_where_the_model_says(false);
+}
+
+#[test]
+fn on_the_fabric_positive_and_negative_moves_land_where_the_model_says() {
+    moves_land_where_the_model_says(true);
+}
+
+fn moves_land_where_the_model_says(fabric: bool) {
+    let board = Board::start_on(fabric);
     let m = Method::Order3 {
         vmax: 0.5,
         amax: 5.0,
@@ -138,7 +156,16 @@ fn positive_and_negative_moves_land_where_the_model_says() {
 
 #[test]
 fn a_corrupted_upload_is_nakked_and_nothing_moves() {
-    let board = Board::start();
+    corrupted_upload(false);
+}
+
+#[test]
+fn on_the_fabric_a_corrupted_upload_is_nakked_and_nothing_moves() {
+    corrupted_upload(true);
+}
+
+fn corrupted_upload(fabric: bool) {
+    let board = Board::start_on(fabric);
     let before = board.position(1);
     let mut args: Vec<&str> = S_CURVE.to_vec();
     args.extend([

@@ -78,6 +78,9 @@ pub struct IoTop {
     pub led_fault: Signal<Out, Bit>,
     /// LED 3: heartbeat.
     pub led_heartbeat: Signal<Out, Bit>,
+    /// The reference position in output LSBs, for simulation (a virtual board's encoder
+    /// follows it) and a future motor model; a board top leaves it unconnected.
+    pub ref_position: Signal<Out, Bits<32>>,
     uart_in: UartRx,
     frames: FrameRx,
     exec: Executor,
@@ -124,6 +127,7 @@ impl IoTop {
             led_busy: Default::default(),
             led_fault: Default::default(),
             led_heartbeat: Default::default(),
+            ref_position: Default::default(),
             uart_in: Default::default(),
             frames: Default::default(),
             exec: Default::default(),
@@ -270,6 +274,7 @@ impl Logic for IoTop {
         self.pwm_gen.fault.next = self.core.aborted.val();
         self.pwm.next = self.pwm_gen.pwm.val();
         self.dir.next = self.pwm_gen.dir.val();
+        self.ref_position.next = self.core.position.val();
         // LEDs.
         self.led_idle.next = !self.core.busy.val();
         self.led_busy.next = self.core.busy.val();

@@ -115,7 +115,22 @@ impl Device {
         !self.decoder.is_idle()
     }
 
-    /// A UART framing error or an inter-byte timeout: a partial frame is dropped and NAKed.
+    /// An inter-byte timeout: a partial frame is dropped, counted and NAKed (FRAMING).
+    pub fn timeout(&mut self) {
+        if self.decoder.reset() {
+            self.bad_frames = self.bad_frames.wrapping_add(1);
+            self.send(
+                Reply::Nak {
+                    cmd: 0,
+                    reason: Reason::Framing,
+                },
+                0,
+            );
+        }
+    }
+
+    /// A UART framing error: the error flag is raised and a partial frame is dropped, counted
+    /// and NAKed (FRAMING).
     pub fn line_error(&mut self) {
         self.errors |= 2;
         if self.decoder.reset() {

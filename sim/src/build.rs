@@ -17,8 +17,10 @@ use std::process::Command;
 
 use crate::SimError;
 
-/// The harness source, compiled into every build.
+/// The harness source of core co-simulation builds.
 pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
+/// The harness source of virtual-board builds (the I/O top).
+pub const IO_HARNESS_CPP: &str = include_str!("../harness/io_harness.cpp");
 /// The Verilator waiver file for the generated core.
 pub const WAIVERS_VLT: &str = include_str!("../../hdl/verilator.vlt");
 
@@ -96,18 +98,32 @@ pub struct Built {
 /// [`crate::wrapper::cosim_top`]), with VCD tracing if `trace`.
 pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
     let verilog = crate::wrapper::cosim_top(core_verilog);
-    let verilog = verilog.as_str();
+    build_with("core", "top.v", &verilog, HARNESS_CPP, trace)
+}
+
+/// Builds (or finds in the cache) the virtual-board library for the I/O top `io_verilog`.
+pub fn build_io(io_verilog: &str) -> Result<Built, SimError> {
+    build_with("io", "io_top.v", io_verilog, IO_HARNESS_CPP, false)
+}
+
+fn build_with(
+    tag: &str,
+    file: &str,
+    verilog: &str,
+    harness: &str,
+    trace: bool,
+) -> Result<Built, SimError> {
     let version = verilator_version()?;
     let key = fnv1a(&[
         verilog.as_bytes(),
         WAIVERS_VLT.as_bytes(),
-        HARNESS_CPP.as_bytes(),
+        harness.as_bytes(),
         version.as_bytes(),
         &[u8::from(trace)],
     ]);
     let root = cache_root();
     let dir = root.join(format!(
-        "core-{key:016x}{}",
+        "{tag}-{key:016x}{}",
         if trace { "-trace" } else { "" }
     ));
     let library = dir.join("libsnapgen_core.so");
@@ -131,9 +147,9 @@ pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
         let p = tmp.join(name);
         fs::write(&p, text).map_err(io("cannot write", &p))
     };
-    write("top.v", verilog)?;
+    write(file, verilog)?;
     write("verilator.vlt", WAIVERS_VLT)?;
-    write("harness.cpp", HARNESS_CPP)?;
+    write("harness.cpp", harness)?;
     let log = tmp.join("build.log");
     let mut cmd = Command::new(verilator_bin());
     cmd.current_dir(&tmp)
@@ -151,7 +167,7 @@ pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
     if trace {
         cmd.arg("--trace");
     }
-    cmd.args(["verilator.vlt", "top.v", "harness.cpp"]);
+    cmd.args(["verilator.vlt", file, "harness.cpp"]);
     let out = cmd.output().map_err(|_| missing_verilator())?;
     let mut text = out.stdout.clone();
     text.extend_from_slice(&out.stderr);

@@ -10,6 +10,7 @@
 //! * [`cosim`] runs both in lockstep and reports the first mismatch.
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
 
+pub mod board;
 pub mod build;
 pub mod cosim;
 pub mod fabric;
