@@ -79,19 +79,6 @@ pub fn motion_core_verilog() -> String {
     header + &direct_clocks(&generate_verilog(&uut))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn clocks_are_wired_directly() {
-        let v = motion_core_verilog();
-        assert!(!v.contains("$clock"));
-        assert!(v.contains(".clock(clock)"));
-        yosys_validate("motion_core_direct_clocks", &v).unwrap();
-    }
-}
-
 /// The I/O top's Verilog (top module `top`, to be written as `io_top.v`).
 pub fn io_top_verilog(cfg: IoTopConfig) -> String {
     let mut uut = IoTop::new(cfg);
@@ -106,4 +93,17 @@ pub fn io_top_verilog(cfg: IoTopConfig) -> String {
         cfg.tick_div
     );
     header + &direct_clocks(&generate_verilog(&uut))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clocks_are_wired_directly() {
+        let v = motion_core_verilog();
+        assert!(!v.contains("$clock"));
+        assert!(v.contains(".clock(clock)"));
+        yosys_validate("motion_core_direct_clocks", &v).unwrap();
+    }
 }
