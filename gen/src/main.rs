@@ -7,6 +7,7 @@
 mod args;
 mod board;
 mod demo;
+mod fpga;
 mod hw;
 mod plot;
 mod report;
@@ -126,6 +127,25 @@ enum Command {
         #[arg(long)]
         clocks_per_second: Option<u64>,
     },
+    /// Write a board build: board top, I/O top, XDC, Vivado TCL and Makefile (--run runs it).
+    Build {
+        /// Board name.
+        #[arg(long, default_value = "zybo-z7-10")]
+        board: String,
+        /// Output directory.
+        #[arg(long, default_value = "out/zybo-z7-10")]
+        out: PathBuf,
+        /// Run the build (needs Vivado, $VIVADO or on the PATH).
+        #[arg(long)]
+        run: bool,
+    },
+    /// Synthesise the board top and the motion core with Yosys: resources, share of the device,
+    /// logic-only timing; exit 1 if the motion core is over its budget.
+    Synth {
+        /// Board name.
+        #[arg(long, default_value = "zybo-z7-10")]
+        board: String,
+    },
     /// Print the fixed-point format: widths, range and resolution of every register.
     Format {
         /// Tick period Ts (s).
@@ -153,6 +173,8 @@ enum InputError {
     Plan(#[from] PlanError),
     #[error("--inject-fault {0:?}: use CLOCK:REGISTER:BIT, e.g. 1000:x:3")]
     Fault(String),
+    #[error("{0}")]
+    Board(String),
 }
 
 /// The co-simulation found a difference (exit 1; the report is already printed).
@@ -289,6 +311,28 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             clocks_per_second: clocks_per_second.unwrap_or(if model { 100_000 } else { 1_000_000 }),
             fabric: !model,
         })?,
+        Command::Build { board, out, run } => {
+            let b = fpga::board(&board).map_err(|e| InputError::Board(e.to_string()))?;
+            let plan = fpga::build_plan(&b);
+            for f in plan.write(&out)? {
+                println!("wrote {}", f.display());
+            }
+            if run {
+                plan.run(&out)?;
+            } else {
+                println!("run it with: make -C {} (needs Vivado)", out.display());
+            }
+        }
+        Command::Synth { board } => {
+            let b = fpga::board(&board).map_err(|e| InputError::Board(e.to_string()))?;
+            let r = fpga::synth(&b)?;
+            print!("{}", r.table());
+            let v = r.violations();
+            if !v.is_empty() {
+                anyhow::bail!("over budget: {}", v.join("; "));
+            }
+            println!("motion core within budget");
+        }
         Command::Demo { out } => demo::run(&out)?,
     }
     Ok(())

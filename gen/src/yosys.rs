@@ -46,6 +46,10 @@ impl Resources {
     pub fn bram(&self) -> u64 {
         self.sum(|k| k.starts_with("RAMB"))
     }
+    /// Block RAM in 36 kb units (a RAMB18 counts one half, rounded up).
+    pub fn bram36(&self) -> u64 {
+        self.sum(|k| k.starts_with("RAMB36")) + self.sum(|k| k.starts_with("RAMB18")).div_ceil(2)
+    }
     /// Latches (must be 0).
     pub fn latches(&self) -> u64 {
         self.sum(|k| k.starts_with("LD"))
@@ -87,7 +91,12 @@ pub fn synth_xilinx(verilog_file: &Path) -> anyhow::Result<Resources> {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let text = String::from_utf8_lossy(&out.stdout);
+    parse_stat(&String::from_utf8_lossy(&out.stdout))
+        .with_context(|| format!("reading Yosys' statistics for {}", verilog_file.display()))
+}
+
+/// The cell counts of the last `stat` block in Yosys' output.
+pub fn parse_stat(text: &str) -> anyhow::Result<Resources> {
     let mut r = Resources::default();
     // The last "Number of cells" block lists the flattened design's cells.
     let block = text.rsplit("Number of cells:").next().unwrap_or("");
@@ -107,10 +116,7 @@ pub fn synth_xilinx(verilog_file: &Path) -> anyhow::Result<Resources> {
         }
     }
     if r.cells.is_empty() {
-        bail!(
-            "could not read Yosys' cell counts for {}",
-            verilog_file.display()
-        );
+        bail!("no cell counts in Yosys' output");
     }
     Ok(r)
 }
