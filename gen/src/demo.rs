@@ -94,6 +94,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         ts,
         tick_div: 0,
         stop_after: None,
+        soft_stop_after: None,
     };
     let moves = vec![
         spec(12.0 * PI, seed001, f.ts),

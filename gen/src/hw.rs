@@ -43,9 +43,10 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     let verilog = snapgen_hdl::verilog::motion_core_verilog();
     let r = cosim::run(&verilog, cfg)?;
     println!(
-        "co-simulation: {} moves ({} stopped midway, {} skipped), {} ticks in {} clocks compared, {} mismatches{}",
+        "co-simulation: {} moves ({} aborted midway, {} with a controlled stop, {} skipped), {} ticks in {} clocks compared, {} mismatches{}",
         r.moves,
         r.stopped,
+        r.soft_stopped,
         r.skipped,
         r.ticks,
         r.clocks,

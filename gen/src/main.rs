@@ -111,6 +111,10 @@ enum Command {
         /// Test hook: corrupt one bit of segment K's frame on every attempt.
         #[arg(long, hide = true)]
         corrupt_segment: Option<u8>,
+        /// Controlled stop this many milliseconds after the start: the cruise is cut short and
+        /// the move decelerates as planned, ending short of the target.
+        #[arg(long)]
+        stop_after_ms: Option<u64>,
         #[command(flatten)]
         plan: PlanArgs,
     },
@@ -277,6 +281,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             timeout_ms,
             retries,
             corrupt_segment,
+            stop_after_ms,
             plan,
         } => {
             let request = plan.request()?;
@@ -287,6 +292,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 timeout: std::time::Duration::from_millis(timeout_ms),
                 retries,
                 corrupt_segment,
+                stop_after: stop_after_ms.map(std::time::Duration::from_millis),
             };
             let r = match send::send(&request, &format, &opts) {
                 Ok(r) => r,
@@ -294,8 +300,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 Err(send::SendFailure::Link(e)) => return Err(e.into()),
             };
             println!(
-                "moved {} units in {} ticks: now at {} LSB = {:.*} units, encoder {} counts; the position register matches the plan bit for bit",
+                "moved {} units{} in {} ticks: now at {} LSB = {:.*} units, encoder {} counts; the position register matches the plan bit for bit",
                 r.plan.request.distance,
+                if u64::from(r.status.tick_count) < r.plan.ticks_total() {
+                    " (controlled stop: cruise cut short)"
+                } else {
+                    ""
+                },
                 r.status.tick_count,
                 r.status.position,
                 (-format.position_lsb.log10()).ceil().max(0.0) as usize,

@@ -112,6 +112,24 @@ pub struct SendOptions {
     pub retries: u32,
     /// Test hook: corrupt one bit of this segment's frame on every attempt.
     pub corrupt_segment: Option<u8>,
+    /// Send a controlled stop this long after the start.
+    pub stop_after: Option<Duration>,
+}
+
+/// Where the move ends after `played` ticks: the plan's end, or — after a controlled stop, which
+/// cuts the cruise short — the same program with a shorter cruise.
+pub fn expected_end(plan: &Plan, start: ChainState, played: u32) -> ChainState {
+    let total = plan.ticks_total();
+    let played = u64::from(played);
+    match plan.cruise_segment {
+        Some(c) if played < total => {
+            let mut p = plan.program.clone();
+            let cut = (total - played).min(u64::from(p.segments[c].ticks) - 1);
+            p.segments[c].ticks -= cut as u32;
+            start.run_program(&p, &plan.format.widths)
+        }
+        _ => plan.final_state,
+    }
 }
 
 /// The outcome of a move.
@@ -131,7 +149,7 @@ fn command_name(c: &Command) -> String {
     match c {
         Command::Ping => "PING".into(),
         Command::LoadSegment { index, .. } => format!("LOAD_SEGMENT {index}"),
-        Command::Commit { count } => format!("COMMIT {count}"),
+        Command::Commit { count, .. } => format!("COMMIT {count}"),
         Command::Start => "START".into(),
         Command::Stop => "STOP".into(),
         Command::Abort => "ABORT".into(),
@@ -359,6 +377,7 @@ pub fn send(
     link.expect_ack(
         Command::Commit {
             count: plan.program.segments.len() as u8,
+            cruise: plan.cruise_segment.map(|c| c as u8),
         },
         false,
     )?;
@@ -373,10 +392,18 @@ pub fn send(
         ProgressBar::hidden()
     };
     link.expect_ack(Command::Start, false)?;
+    let started = Instant::now();
+    let mut stop_sent = false;
     let stall = Duration::from_secs(5);
     let mut last_progress = (Instant::now(), u32::MAX);
     let status = loop {
-        let _ = link.read_replies(Duration::from_millis(50))?;
+        let _ = link.read_replies(Duration::from_millis(20))?;
+        if let Some(after) = opts.stop_after {
+            if !stop_sent && started.elapsed() >= after {
+                link.expect_ack(Command::Stop, false)?;
+                stop_sent = true;
+            }
+        }
         let s = match link.telemetry.take() {
             Some((_, s)) => s,
             None => link.status()?,
@@ -417,10 +444,11 @@ pub fn send(
         tick_count: status.tick_count,
         ..last
     };
-    if x != plan.final_state.x {
+    let want = expected_end(&plan, ChainState::at_rest(x0), status.tick_count);
+    if x != want.x {
         return Err(SendError::WrongEnd {
             got: x,
-            want: plan.final_state.x,
+            want: want.x,
         }
         .into());
     }

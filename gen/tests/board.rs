@@ -239,3 +239,38 @@ fn nix_free_pty() -> String {
     std::mem::forget(board);
     port
 }
+
+#[test]
+fn a_controlled_stop_ends_short_at_rest_on_the_fabric_and_the_model() {
+    for fabric in [false, true] {
+        let board = Board::start_on(fabric);
+        // 0.2 units at 0.5 units/s: about 0.5 s with a 0.3 s cruise; stop 150 ms in.
+        let out = send(
+            &board.port,
+            &[
+                "--order",
+                "3",
+                "--vmax",
+                "0.5",
+                "--amax",
+                "5",
+                "--jmax",
+                "100",
+                "--distance",
+                "0.2",
+                "--stop-after-ms",
+                "150",
+            ],
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(text.contains("controlled stop: cruise cut short"), "{text}");
+        let s = board.status(77);
+        assert_eq!(s.state & 7, 2, "done, not busy, not aborted");
+        assert!(s.position > 0 && s.position < 200_000, "{s:?}");
+    }
+}

@@ -44,6 +44,10 @@ pub struct MotionCore {
     pub count_enable: Signal<In, Bit>,
     /// Segment count to set.
     pub count_value: Signal<In, Bits<INDEX_BITS>>,
+    /// Cruise segment of the standby program, set with the count (63: none).
+    pub cruise_value: Signal<In, Bits<INDEX_BITS>>,
+    /// Controlled stop: end the cruise early and decelerate as planned.
+    pub soft_stop: Signal<In, Bit>,
     /// Position register, raw.
     pub x: Signal<Out, Bits<X_BITS>>,
     /// Velocity register, raw.
@@ -77,6 +81,8 @@ pub struct MotionCore {
     bank: DFF<Bit>,
     count0: DFF<Bits<INDEX_BITS>>,
     count1: DFF<Bits<INDEX_BITS>>,
+    cruise0: DFF<Bits<INDEX_BITS>>,
+    cruise1: DFF<Bits<INDEX_BITS>>,
     aborted_reg: DFF<Bit>,
     read_bank: Signal<Local, Bit>,
     count_zero: Constant<Bits<INDEX_BITS>>,
@@ -96,6 +102,8 @@ impl Default for MotionCore {
             write_snap: Default::default(),
             count_enable: Default::default(),
             count_value: Default::default(),
+            cruise_value: Default::default(),
+            soft_stop: Default::default(),
             x: Default::default(),
             v: Default::default(),
             a: Default::default(),
@@ -116,6 +124,8 @@ impl Default for MotionCore {
             bank: Default::default(),
             count0: Default::default(),
             count1: Default::default(),
+            cruise0: Default::default(),
+            cruise1: Default::default(),
             aborted_reg: Default::default(),
             read_bank: Default::default(),
             count_zero: Constant::new(0.into()),
@@ -127,7 +137,16 @@ impl Logic for MotionCore {
     #[hdl_gen]
     fn update(&mut self) {
         clock!(self, clock, divider, memory, sequencer, chain);
-        dff_setup!(self, clock, bank, count0, count1, aborted_reg);
+        dff_setup!(
+            self,
+            clock,
+            bank,
+            count0,
+            count1,
+            cruise0,
+            cruise1,
+            aborted_reg
+        );
         self.divider.reset.next = self.reset.val();
         self.divider.divisor.next = self.tick_div.val();
         // While playing, read the active bank; while idle, the standby bank (the next start's).
@@ -136,8 +155,10 @@ impl Logic for MotionCore {
         self.memory.read_address.next = self.sequencer.address.val();
         if self.read_bank.val() {
             self.sequencer.count.next = self.count1.q.val();
+            self.sequencer.cruise.next = self.cruise1.q.val();
         } else {
             self.sequencer.count.next = self.count0.q.val();
+            self.sequencer.cruise.next = self.cruise0.q.val();
         }
         // Writes go to the standby bank.
         self.memory.write_bank.next = !self.bank.q.val();
@@ -149,6 +170,7 @@ impl Logic for MotionCore {
         self.sequencer.tick.next = self.divider.tick.val();
         self.sequencer.start.next = self.start.val();
         self.sequencer.stop.next = self.stop.val();
+        self.sequencer.soft_stop.next = self.soft_stop.val();
         self.sequencer.entry_ticks.next = self.memory.read_ticks.val();
         self.sequencer.entry_snap.next = self.memory.read_snap.val();
         self.chain.reset.next = self.reset.val();
@@ -159,6 +181,8 @@ impl Logic for MotionCore {
             self.bank.d.next = false;
             self.count0.d.next = self.count_zero.val();
             self.count1.d.next = self.count_zero.val();
+            self.cruise0.d.next = self.count_zero.val();
+            self.cruise1.d.next = self.count_zero.val();
             self.aborted_reg.d.next = false;
         } else if self.sequencer.started.val() {
             // Swap: the standby bank plays; the old active bank becomes standby, emptied.
@@ -172,8 +196,10 @@ impl Logic for MotionCore {
         } else if self.count_enable.val() {
             if self.bank.q.val() {
                 self.count0.d.next = self.count_value.val();
+                self.cruise0.d.next = self.cruise_value.val();
             } else {
                 self.count1.d.next = self.count_value.val();
+                self.cruise1.d.next = self.cruise_value.val();
             }
         }
         if self.stop.val() & !self.reset.val() {

@@ -2,8 +2,9 @@
 //! checks the command and its length and arguments, drives the motion core for one clock
 //! (segment write, count, start, stop), updates the configuration, and requests the reply. Bad
 //! CRCs and dropped frames are counted and NAKed; a UART framing error raises an error flag. A
-//! LOAD_SEGMENT, COMMIT, START, ABORT or CONFIGURE with the same command and sequence as the
-//! last such one is answered again without executing it. While a move runs, a telemetry
+//! LOAD_SEGMENT, COMMIT, START, STOP, ABORT or CONFIGURE with the same command and sequence as
+//! the last such one is answered again without executing it. STOP is the controlled stop: the
+//! core ends the cruise segment (named by a two-byte COMMIT) and decelerates as planned. While a move runs, a telemetry
 //! request goes out every `telemetry_period` ticks, and one when it ends.
 
 use rust_hdl::prelude::*;
@@ -44,8 +45,10 @@ pub struct Executor {
     pub seg_ticks: Signal<In, Bits<TICK_BITS>>,
     /// LOAD_SEGMENT snap.
     pub seg_snap: Signal<In, Bits<D_BITS>>,
-    /// COMMIT count.
+    /// Last payload byte (COMMIT count, or the cruise of a two-byte COMMIT).
     pub commit_count: Signal<In, Bits<8>>,
+    /// Payload byte before the last (count of a two-byte COMMIT).
+    pub commit_first: Signal<In, Bits<8>>,
     /// CONFIGURE parameter.
     pub cfg_param: Signal<In, Bits<8>>,
     /// CONFIGURE value.
@@ -70,6 +73,10 @@ pub struct Executor {
     pub count_enable: Signal<Out, Bit>,
     /// Core: count value.
     pub count_value: Signal<Out, Bits<INDEX_BITS>>,
+    /// Core: cruise segment of the program (63: none).
+    pub cruise_value: Signal<Out, Bits<INDEX_BITS>>,
+    /// Core: controlled stop.
+    pub soft_stop: Signal<Out, Bit>,
     /// Core: start.
     pub start: Signal<Out, Bit>,
     /// Core: stop (abort).
@@ -104,6 +111,8 @@ pub struct Executor {
     ws: DFF<Bits<D_BITS>>,
     ce: DFF<Bit>,
     cv: DFF<Bits<INDEX_BITS>>,
+    cr: DFF<Bits<INDEX_BITS>>,
+    ss: DFF<Bit>,
     st: DFF<Bit>,
     sp: DFF<Bit>,
     tick_div_reg: DFF<Bits<32>>,
@@ -159,6 +168,8 @@ pub struct Executor {
     b5: Constant<Bits<8>>,
     b18: Constant<Bits<8>>,
     b32: Constant<Bits<8>>,
+    b255: Constant<Bits<8>>,
+    no_cruise: Constant<Bits<INDEX_BITS>>,
     t0: Constant<Bits<32>>,
     t1: Constant<Bits<32>>,
     n0: Constant<Bits<16>>,
@@ -184,6 +195,7 @@ impl Default for Executor {
             seg_ticks: Default::default(),
             seg_snap: Default::default(),
             commit_count: Default::default(),
+            commit_first: Default::default(),
             cfg_param: Default::default(),
             cfg_value: Default::default(),
             busy: Default::default(),
@@ -196,6 +208,8 @@ impl Default for Executor {
             write_snap: Default::default(),
             count_enable: Default::default(),
             count_value: Default::default(),
+            cruise_value: Default::default(),
+            soft_stop: Default::default(),
             start: Default::default(),
             stop: Default::default(),
             tick_div: Default::default(),
@@ -216,6 +230,8 @@ impl Default for Executor {
             ws: Default::default(),
             ce: Default::default(),
             cv: Default::default(),
+            cr: Default::default(),
+            ss: Default::default(),
             st: Default::default(),
             sp: Default::default(),
             tick_div_reg: Default::default(),
@@ -271,6 +287,8 @@ impl Default for Executor {
             b5: b(5),
             b18: b(18),
             b32: b(32),
+            b255: b(255),
+            no_cruise: Constant::new(63.into()),
             t0: Constant::new(0.into()),
             t1: Constant::new(1.into()),
             n0: Constant::new(0.into()),
@@ -293,6 +311,8 @@ impl Logic for Executor {
             ws,
             ce,
             cv,
+            cr,
+            ss,
             st,
             sp,
             tick_div_reg,
@@ -318,6 +338,7 @@ impl Logic for Executor {
         );
         self.we.d.next = false;
         self.ce.d.next = false;
+        self.ss.d.next = false;
         self.st.d.next = false;
         self.sp.d.next = false;
         self.rq.d.next = false;
@@ -330,6 +351,7 @@ impl Logic for Executor {
         self.effect.next = (self.cmd.val() == self.c_load.val())
             | (self.cmd.val() == self.c_commit.val())
             | (self.cmd.val() == self.c_start.val())
+            | (self.cmd.val() == self.c_stop.val())
             | (self.cmd.val() == self.c_abort.val())
             | (self.cmd.val() == self.c_config.val());
         if self.cmd.val() == self.c_ping.val() {
@@ -358,6 +380,16 @@ impl Logic for Executor {
                 } else {
                     self.reason.next = self.r_bad_argument.val();
                 }
+            } else if self.len.val() == self.b2.val() {
+                // Count, then the cruise segment (< 32, or 255 for none).
+                if (self.commit_first.val() <= self.b32.val())
+                    & ((self.commit_count.val() < self.b32.val())
+                        | (self.commit_count.val() == self.b255.val()))
+                {
+                    self.kind.next = self.k_ack.val();
+                } else {
+                    self.reason.next = self.r_bad_argument.val();
+                }
             } else {
                 self.reason.next = self.r_bad_length.val();
                 self.counted.next = true;
@@ -375,13 +407,7 @@ impl Logic for Executor {
                 self.reason.next = self.r_bad_length.val();
                 self.counted.next = true;
             }
-        } else if self.cmd.val() == self.c_stop.val() {
-            // Controlled stop is not built: refused, but a well-formed frame is not "bad".
-            if self.len.val() != self.b0.val() {
-                self.reason.next = self.r_bad_length.val();
-                self.counted.next = true;
-            }
-        } else if self.cmd.val() == self.c_abort.val() {
+        } else if (self.cmd.val() == self.c_stop.val()) | (self.cmd.val() == self.c_abort.val()) {
             if self.len.val() == self.b0.val() {
                 self.kind.next = self.k_ack.val();
             } else {
@@ -454,7 +480,16 @@ impl Logic for Executor {
                     }
                     if self.cmd.val() == self.c_commit.val() {
                         self.ce.d.next = true;
-                        self.cv.d.next = self.commit_count.val().get_bits::<INDEX_BITS>(0);
+                        if self.len.val() == self.b1.val() {
+                            self.cv.d.next = self.commit_count.val().get_bits::<INDEX_BITS>(0);
+                            self.cr.d.next = self.no_cruise.val();
+                        } else {
+                            self.cv.d.next = self.commit_first.val().get_bits::<INDEX_BITS>(0);
+                            self.cr.d.next = self.commit_count.val().get_bits::<INDEX_BITS>(0);
+                        }
+                    }
+                    if self.cmd.val() == self.c_stop.val() {
+                        self.ss.d.next = true;
                     }
                     if self.cmd.val() == self.c_start.val() {
                         self.st.d.next = true;
@@ -525,6 +560,8 @@ impl Logic for Executor {
         self.write_snap.next = self.ws.q.val();
         self.count_enable.next = self.ce.q.val();
         self.count_value.next = self.cv.q.val();
+        self.cruise_value.next = self.cr.q.val();
+        self.soft_stop.next = self.ss.q.val();
         self.start.next = self.st.q.val();
         self.stop.next = self.sp.q.val();
         self.tick_div.next = self.tick_div_reg.q.val();

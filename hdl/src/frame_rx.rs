@@ -43,8 +43,10 @@ pub struct FrameRx {
     pub seg_ticks: Signal<Out, Bits<TICK_BITS>>,
     /// LOAD_SEGMENT snap.
     pub seg_snap: Signal<Out, Bits<D_BITS>>,
-    /// COMMIT count.
+    /// Last payload byte (COMMIT count, or the cruise index of a two-byte COMMIT).
     pub commit_count: Signal<Out, Bits<8>>,
+    /// Payload byte before the last (the count of a two-byte COMMIT).
+    pub commit_first: Signal<Out, Bits<8>>,
     /// CONFIGURE parameter.
     pub cfg_param: Signal<Out, Bits<8>>,
     /// CONFIGURE value.
@@ -97,6 +99,7 @@ impl Default for FrameRx {
             seg_ticks: Default::default(),
             seg_snap: Default::default(),
             commit_count: Default::default(),
+            commit_first: Default::default(),
             cfg_param: Default::default(),
             cfg_value: Default::default(),
             step: Default::default(),
@@ -237,6 +240,7 @@ impl Logic for FrameRx {
         self.seg_ticks.next = self.payload.seg_ticks.val();
         self.seg_snap.next = self.payload.seg_snap.val();
         self.commit_count.next = self.payload.commit_count.val();
+        self.commit_first.next = self.payload.commit_first.val();
         self.cfg_param.next = self.payload.cfg_param.val();
         self.cfg_value.next = self.payload.cfg_value.val();
     }

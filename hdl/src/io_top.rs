@@ -192,6 +192,7 @@ impl Logic for IoTop {
         self.exec.seg_ticks.next = self.frames.seg_ticks.val();
         self.exec.seg_snap.next = self.frames.seg_snap.val();
         self.exec.commit_count.next = self.frames.commit_count.val();
+        self.exec.commit_first.next = self.frames.commit_first.val();
         self.exec.cfg_param.next = self.frames.cfg_param.val();
         self.exec.cfg_value.next = self.frames.cfg_value.val();
         self.exec.busy.next = self.core.busy.val();
@@ -209,6 +210,8 @@ impl Logic for IoTop {
         self.core.write_snap.next = self.exec.write_snap.val();
         self.core.count_enable.next = self.exec.count_enable.val();
         self.core.count_value.next = self.exec.count_value.val();
+        self.core.cruise_value.next = self.exec.cruise_value.val();
+        self.core.soft_stop.next = self.exec.soft_stop.val();
         // Encoder.
         self.encoder.a.next = self.enc_a.val();
         self.encoder.b.next = self.enc_b.val();

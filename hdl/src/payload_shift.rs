@@ -1,7 +1,7 @@
 //! The last 18 payload bytes of a frame, shifted in one at a time (the newest at the top), with
 //! the command fields read from where each command's payload lands (docs/PROTOCOL.md):
-//! LOAD_SEGMENT (18 bytes): index, ticks, snap; COMMIT (1 byte): count; CONFIGURE (5 bytes):
-//! param, value. The field wiring is byte concatenation, which `#[hdl_gen]` cannot express, so
+//! LOAD_SEGMENT (18 bytes): index, ticks, snap; COMMIT (1 or 2 bytes): count and cruise
+//! segment; CONFIGURE (5 bytes): param, value. The field wiring is byte concatenation, which `#[hdl_gen]` cannot express, so
 //! this block writes its Verilog and models it for rust-hdl's simulator.
 
 use rust_hdl::prelude::*;
@@ -26,8 +26,10 @@ pub struct PayloadShift {
     pub seg_ticks: Signal<Out, Bits<TICK_BITS>>,
     /// LOAD_SEGMENT snap.
     pub seg_snap: Signal<Out, Bits<D_BITS>>,
-    /// COMMIT count.
+    /// COMMIT count (one-byte COMMIT) or cruise index (two-byte COMMIT): the last byte.
     pub commit_count: Signal<Out, Bits<8>>,
+    /// COMMIT count of a two-byte COMMIT: the byte before the last.
+    pub commit_first: Signal<Out, Bits<8>>,
     /// CONFIGURE parameter.
     pub cfg_param: Signal<Out, Bits<8>>,
     /// CONFIGURE value.
@@ -66,6 +68,7 @@ impl Logic for PayloadShift {
         self.seg_ticks.next = bits(le(&p[1..5]));
         self.seg_snap.next = bits(le(&p[5..18]));
         self.commit_count.next = bits(u128::from(p[17]));
+        self.commit_first.next = bits(u128::from(p[16]));
         self.cfg_param.next = bits(u128::from(p[13]));
         self.cfg_value.next = bits(le(&p[14..18]));
     }
@@ -75,6 +78,7 @@ impl Logic for PayloadShift {
         self.seg_ticks.connect();
         self.seg_snap.connect();
         self.commit_count.connect();
+        self.commit_first.connect();
         self.cfg_param.connect();
         self.cfg_value.connect();
     }
@@ -99,6 +103,7 @@ always @(*) begin
    seg_ticks = {{p[4], p[3], p[2], p[1]}};
    seg_snap = {{{snap}}};
    commit_count = p[17];
+   commit_first = p[16];
    cfg_param = p[13];
    cfg_value = {{p[17], p[16], p[15], p[14]}};
 end

@@ -23,6 +23,10 @@ pub struct Sequencer {
     pub start: Signal<In, Bit>,
     /// Stop now.
     pub stop: Signal<In, Bit>,
+    /// Controlled stop: end the cruise segment on its next tick (armed until the next start).
+    pub soft_stop: Signal<In, Bit>,
+    /// Index of the cruise segment of the program being read (63: none).
+    pub cruise: Signal<In, Bits<INDEX_BITS>>,
     /// Segments in the program (of the bank being read).
     pub count: Signal<In, Bits<INDEX_BITS>>,
     /// Memory read data at `address`: tick count.
@@ -49,7 +53,9 @@ pub struct Sequencer {
     left: DFF<Bits<TICK_BITS>>,
     snap_reg: DFF<Bits<D_BITS>>,
     tick_count_reg: DFF<Bits<TICK_BITS>>,
+    skip: DFF<Bit>,
     next_index: Signal<Local, Bits<INDEX_BITS>>,
+    cut: Signal<Local, Bit>,
     // Sized constants (rust-hdl emits bare literals as 32-bit: WIDTH warnings).
     index_zero: Constant<Bits<INDEX_BITS>>,
     index_one: Constant<Bits<INDEX_BITS>>,
@@ -67,6 +73,8 @@ impl Default for Sequencer {
             tick: Default::default(),
             start: Default::default(),
             stop: Default::default(),
+            soft_stop: Default::default(),
+            cruise: Default::default(),
             count: Default::default(),
             entry_ticks: Default::default(),
             entry_snap: Default::default(),
@@ -83,7 +91,9 @@ impl Default for Sequencer {
             left: Default::default(),
             snap_reg: Default::default(),
             tick_count_reg: Default::default(),
+            skip: Default::default(),
             next_index: Default::default(),
+            cut: Default::default(),
             index_zero: Constant::new(0.into()),
             index_one: Constant::new(1.into()),
             address_zero: Constant::new(0.into()),
@@ -105,8 +115,10 @@ impl Logic for Sequencer {
             index_reg,
             left,
             snap_reg,
-            tick_count_reg
+            tick_count_reg,
+            skip
         );
+        self.cut.next = self.skip.q.val() & (self.index_reg.q.val() == self.cruise.val());
         self.next_index.next = self.index_reg.q.val() + self.index_one.val();
         if self.busy_reg.q.val() {
             self.address.next = self.next_index.val().get_bits::<ADDR_BITS>(0);
@@ -139,7 +151,7 @@ impl Logic for Sequencer {
             }
         } else if self.tick.val() & self.busy_reg.q.val() {
             self.tick_count_reg.d.next = self.tick_count_reg.q.val() + self.ticks_one.val();
-            if self.left.q.val() == self.ticks_one.val() {
+            if (self.left.q.val() == self.ticks_one.val()) | self.cut.val() {
                 self.index_reg.d.next = self.next_index.val();
                 if self.next_index.val() == self.count.val() {
                     self.busy_reg.d.next = false;
@@ -152,6 +164,12 @@ impl Logic for Sequencer {
             } else {
                 self.left.d.next = self.left.q.val() - self.ticks_one.val();
             }
+        }
+        // The controlled stop is armed while playing and cleared by a start or a reset.
+        if self.reset.val() | (self.start.val() & !self.busy_reg.q.val() & !self.stop.val()) {
+            self.skip.d.next = false;
+        } else if self.soft_stop.val() & self.busy_reg.q.val() & !self.stop.val() {
+            self.skip.d.next = true;
         }
         self.snap.next = self.snap_reg.q.val();
         self.busy.next = self.busy_reg.q.val();

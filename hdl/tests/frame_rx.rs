@@ -46,6 +46,7 @@ fn fields(f: &Frame) -> Vec<u128> {
         18 => vec![u128::from(p[0]), le(&p[1..5]), le(&p[5..18])],
         5 => vec![u128::from(p[0]), le(&p[1..5])],
         1 => vec![u128::from(p[0])],
+        2 => vec![u128::from(p[0]), u128::from(p[1])],
         _ => vec![],
     }
 }
@@ -69,6 +70,7 @@ fn stimulus(seed: u64) -> (Vec<(u8, u64)>, Vec<Event>) {
             },
             2 => Command::Commit {
                 count: r.below(40) as u8,
+                cruise: (r.below(2) == 0).then(|| r.below(40) as u8),
             },
             3 => Command::Configure {
                 param: Param::TelemetryPeriod,
@@ -155,6 +157,10 @@ fn frame_receiver_matches_the_device_decoder() {
                         x.cfg_value.val().to_u64().into(),
                     ],
                     1 => vec![x.commit_count.val().to_u64().into()],
+                    2 => vec![
+                        x.commit_first.val().to_u64().into(),
+                        x.commit_count.val().to_u64().into(),
+                    ],
                     _ => vec![],
                 };
                 got.push(Event::Frame {

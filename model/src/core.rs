@@ -44,6 +44,11 @@ pub struct CoreInputs {
     pub count_enable: bool,
     /// Segment count (0..=32).
     pub count_value: u8,
+    /// Cruise segment of the standby program, written with the count (63: none).
+    pub cruise_value: u8,
+    /// Controlled stop: end the cruise now (or as soon as it is reached) and decelerate as
+    /// planned. Ignored while idle.
+    pub soft_stop: bool,
 }
 
 /// The core's outputs after a clock edge.
@@ -85,6 +90,8 @@ pub struct CoreModel {
     mem_ticks: [[u32; BANK_DEPTH]; 2],
     mem_snap: [[i128; BANK_DEPTH]; 2],
     counts: [u8; 2],
+    cruise: [u8; 2],
+    skip: bool,
     bank: bool,
     aborted: bool,
     divider: u32,
@@ -108,6 +115,8 @@ impl CoreModel {
             mem_ticks: [[0; BANK_DEPTH]; 2],
             mem_snap: [[0; BANK_DEPTH]; 2],
             counts: [0; 2],
+            cruise: [0; 2],
+            skip: false,
             bank: false,
             aborted: false,
             divider: 0,
@@ -156,6 +165,9 @@ impl CoreModel {
         let started = !i.reset && !i.stop && i.start && !self.busy;
         let old_snap = self.snap;
         let old_bank = self.bank;
+        // A controlled stop ends the cruise segment on its next tick.
+        let cut = self.skip && self.index == self.cruise[read_bank];
+        let old_busy = self.busy;
 
         // Sequencer.
         if i.reset {
@@ -182,7 +194,7 @@ impl CoreModel {
             }
         } else if tick && self.busy {
             self.tick_count = self.tick_count.wrapping_add(1);
-            if self.left == 1 {
+            if self.left == 1 || cut {
                 self.index = next_index;
                 if next_index == count {
                     self.busy = false;
@@ -217,6 +229,7 @@ impl CoreModel {
         if i.reset {
             self.bank = false;
             self.counts = [0; 2];
+            self.cruise = [0; 2];
             self.aborted = false;
         } else if started {
             self.bank = !old_bank;
@@ -224,6 +237,13 @@ impl CoreModel {
             self.counts[usize::from(old_bank)] = 0;
         } else if i.count_enable {
             self.counts[usize::from(!old_bank)] = i.count_value & 0x3f;
+            self.cruise[usize::from(!old_bank)] = i.cruise_value & 0x3f;
+        }
+        // Controlled stop: armed while playing, cleared by a start or a reset.
+        if i.reset || started {
+            self.skip = false;
+        } else if i.soft_stop && old_busy && !i.stop {
+            self.skip = true;
         }
         if i.stop && !i.reset {
             self.aborted = true;
@@ -328,6 +348,69 @@ mod tests {
             ..Default::default()
         });
         assert!(!m.busy() && m.outputs().done);
+    }
+
+    #[test]
+    fn a_controlled_stop_cuts_the_cruise_and_lands_at_rest() {
+        use crate::planner::{plan, Method, MoveRequest};
+        let f = DEFAULT_FORMAT;
+        let p = plan(
+            &MoveRequest {
+                distance: 0.5,
+                method: Method::Order4 {
+                    vmax: 1.0,
+                    amax: 5.0,
+                    jmax: 50.0,
+                    dmax: 1000.0,
+                },
+            },
+            &f,
+        )
+        .unwrap();
+        let cruise = p.cruise_segment.expect("this move cruises");
+        assert_eq!(p.program.segments[cruise].ticks, 15_000);
+        let mut m = CoreModel::new(&f);
+        m.clock(&CoreInputs {
+            reset: true,
+            ..Default::default()
+        });
+        for (k, s) in p.program.segments.iter().enumerate() {
+            m.clock(&CoreInputs {
+                write_enable: true,
+                write_address: k as u8,
+                write_ticks: s.ticks,
+                write_snap: s.snap,
+                ..Default::default()
+            });
+        }
+        m.clock(&CoreInputs {
+            count_enable: true,
+            count_value: p.program.segments.len() as u8,
+            cruise_value: cruise as u8,
+            ..Default::default()
+        });
+        m.clock(&CoreInputs {
+            start: true,
+            ..Default::default()
+        });
+        // 35 000 ticks of acceleration, then 5 000 of cruise, then the stop.
+        for _ in 0..40_000 {
+            m.clock(&CoreInputs::default());
+        }
+        m.clock(&CoreInputs {
+            soft_stop: true,
+            ..Default::default()
+        });
+        while m.busy() {
+            m.clock(&CoreInputs::default());
+        }
+        let played = u64::from(m.outputs().tick_count);
+        let mut short = p.program.clone();
+        short.segments[cruise].ticks -= (p.ticks_total() - played) as u32;
+        let want = ChainState::at_rest(f.home_raw()).run_program(&short, &f.widths);
+        assert!(played < p.ticks_total());
+        assert_eq!(m.chain(), want);
+        assert!(m.chain().is_at_rest());
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! fabric's command interface will be compared with, and what `snapgen board --pty` serves.
 //!
 //! Command effects, each one core clock: LOAD_SEGMENT writes the standby bank; COMMIT sets its
-//! count; START (idle, with a committed program) starts it; ABORT stops at once; CONFIGURE sets
+//! count (and cruise segment); START (idle, with a committed program) starts it; STOP cuts the
+//! cruise short (controlled stop); ABORT stops at once; CONFIGURE sets
 //! the tick divider or the telemetry period (PWM period and encoder filter are recorded for the
 //! fabric's blocks). The encoder input follows the reference position exactly (an ideal motor,
 //! one count per output LSB) until a motor model exists.
@@ -190,7 +191,12 @@ impl Device {
         let bytes = self.send(reply, f.seq);
         if matches!(
             f.cmd,
-            code::LOAD_SEGMENT | code::COMMIT | code::START | code::ABORT | code::CONFIGURE
+            code::LOAD_SEGMENT
+                | code::COMMIT
+                | code::START
+                | code::STOP
+                | code::ABORT
+                | code::CONFIGURE
         ) {
             self.last = Some((f.cmd, f.seq, bytes));
         }
@@ -214,10 +220,11 @@ impl Device {
                 });
                 ack
             }
-            Command::Commit { count } => {
+            Command::Commit { count, cruise } => {
                 self.clock(CoreInputs {
                     count_enable: true,
                     count_value: count,
+                    cruise_value: cruise.unwrap_or(0xFF) & 0x3f,
                     ..Default::default()
                 });
                 ack
@@ -241,10 +248,13 @@ impl Device {
                     ack
                 }
             }
-            Command::Stop => Reply::Nak {
-                cmd: code::STOP,
-                reason: Reason::UnknownCommand,
-            },
+            Command::Stop => {
+                self.clock(CoreInputs {
+                    soft_stop: true,
+                    ..Default::default()
+                });
+                ack
+            }
             Command::Abort => {
                 self.clock(CoreInputs {
                     stop: true,
@@ -356,7 +366,13 @@ mod tests {
         }
         let n = p.program.segments.len() as u8;
         assert_eq!(
-            send(&mut d, Command::Commit { count: n }),
+            send(
+                &mut d,
+                Command::Commit {
+                    count: n,
+                    cruise: None
+                }
+            ),
             vec![Reply::Ack { cmd: code::COMMIT }]
         );
         assert_eq!(

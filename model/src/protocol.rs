@@ -154,10 +154,13 @@ pub enum Command {
     Commit {
         /// Segment count.
         count: u8,
+        /// The cruise segment, which a controlled stop cuts short (sent as a second payload
+        /// byte; `None` sends a one-byte COMMIT).
+        cruise: Option<u8>,
     },
     /// Start the standby program.
     Start,
-    /// Controlled stop (play the standby stop profile now).
+    /// Controlled stop: end the cruise now (or when it is reached) and decelerate as planned.
     Stop,
     /// Abort.
     Abort,
@@ -414,7 +417,10 @@ impl Command {
                 p.extend_from_slice(&segment.snap.to_le_bytes()[..nb]);
                 p
             }
-            Command::Commit { count } => vec![count],
+            Command::Commit { count, cruise } => match cruise {
+                Some(c) => vec![count, c],
+                None => vec![count],
+            },
             Command::Configure { param, value } => {
                 let mut p = vec![param as u8];
                 p.extend_from_slice(&value.to_le_bytes());
@@ -474,11 +480,20 @@ impl Command {
                 Command::LoadSegment { index, segment }
             }
             code::COMMIT => {
-                need(1)?;
+                if p.len() != 1 && p.len() != 2 {
+                    return Err(reject(Reason::BadLength));
+                }
                 if usize::from(p[0]) > format.max_segments {
                     return Err(reject(Reason::BadArgument));
                 }
-                Command::Commit { count: p[0] }
+                let cruise = p.get(1).copied();
+                if cruise.is_some_and(|c| usize::from(c) >= format.max_segments && c != 0xFF) {
+                    return Err(reject(Reason::BadArgument));
+                }
+                Command::Commit {
+                    count: p[0],
+                    cruise,
+                }
             }
             code::START => {
                 need(0)?;
@@ -633,8 +648,26 @@ mod tests {
             "A5 12 02 07 02 88 13 00 00 4E 43 0F 40 01 F5 FF FF FF FF FF FF FF 15 3C"
         );
         assert_eq!(
-            hex(&Command::Commit { count: 15 }.to_frame(0x08, &f).to_bytes()),
+            hex(&Command::Commit {
+                count: 15,
+                cruise: None
+            }
+            .to_frame(0x08, &f)
+            .to_bytes()),
             "A5 01 03 08 0F 62 D3"
+        );
+        assert_eq!(
+            hex(&Command::Commit {
+                count: 15,
+                cruise: Some(7)
+            }
+            .to_frame(0x08, &f)
+            .to_bytes()),
+            "A5 02 03 08 0F 07 2B 07"
+        );
+        assert_eq!(
+            hex(&Reply::Ack { cmd: code::STOP }.to_frame(0x0C).to_bytes()),
+            "A5 01 7E 0C 05 B5 24"
         );
         assert_eq!(
             hex(&Command::Start.to_frame(0x09, &f).to_bytes()),
@@ -755,7 +788,14 @@ mod tests {
                     snap: -(1i128 << 103),
                 },
             },
-            Command::Commit { count: 32 },
+            Command::Commit {
+                count: 32,
+                cruise: None,
+            },
+            Command::Commit {
+                count: 15,
+                cruise: Some(7),
+            },
             Command::Start,
             Command::Stop,
             Command::Abort,

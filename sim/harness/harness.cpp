@@ -20,7 +20,7 @@ void Vtop___024root___eval(Vtop___024root* vlSelf);
 enum {
     IN_RESET = 0, IN_TICK_DIV, IN_START, IN_STOP, IN_WRITE_ENABLE, IN_WRITE_ADDRESS,
     IN_WRITE_TICKS, IN_WRITE_SNAP0, IN_WRITE_SNAP1, IN_WRITE_SNAP2, IN_WRITE_SNAP3,
-    IN_COUNT_ENABLE, IN_COUNT_VALUE, IN_WORDS
+    IN_COUNT_ENABLE, IN_COUNT_VALUE, IN_CRUISE_VALUE, IN_SOFT_STOP, IN_WORDS
 };
 enum {
     OUT_X0 = 0, OUT_V0 = 4, OUT_A0 = 8, OUT_J0 = 12, OUT_POSITION = 16, OUT_FLAGS = 17,
@@ -104,6 +104,8 @@ void snapgen_core_set(void* h, const uint32_t* in) {
     for (int k = 0; k < 4; ++k) t->write_snap[k] = in[IN_WRITE_SNAP0 + k];
     t->count_enable = in[IN_COUNT_ENABLE] & 1;
     t->count_value = in[IN_COUNT_VALUE] & 0x3f;
+    t->cruise_value = in[IN_CRUISE_VALUE] & 0x3f;
+    t->soft_stop = in[IN_SOFT_STOP] & 1;
 }
 
 // Runs n rising clock edges with the inputs last set; out receives OUT_WORDS words per clock,

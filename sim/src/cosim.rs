@@ -292,8 +292,10 @@ impl CosimConfig {
 pub struct CosimReport {
     /// Moves played.
     pub moves: usize,
-    /// Moves stopped midway.
+    /// Moves aborted midway.
     pub stopped: usize,
+    /// Moves given a controlled stop.
+    pub soft_stopped: usize,
     /// Moves the stream drew but the planner refused or that were too long (skipped).
     pub skipped: usize,
     /// Clocks compared.
@@ -472,6 +474,7 @@ fn session(
                 &CoreInputs {
                     count_enable: true,
                     count_value: plan.program.segments.len() as u8,
+                    cruise_value: plan.cruise_segment.map_or(63, |c| c as u8),
                     ..idle
                 },
                 1,
@@ -492,13 +495,36 @@ fn session(
                 ls.drive(&CoreInputs { stop: true, ..idle }, 1)?;
                 report.stopped += 1;
             } else {
+                if let Some(after) = spec.soft_stop_after {
+                    let k = after.min(budget);
+                    ls.drive(&idle, k)?;
+                    budget -= k;
+                    ls.drive(
+                        &CoreInputs {
+                            soft_stop: true,
+                            ..idle
+                        },
+                        1,
+                    )?;
+                    report.soft_stopped += 1;
+                }
                 while ls.model.busy() && budget > 0 {
                     let k = budget.min(BATCH);
                     ls.drive(&idle, k)?;
                     budget -= k;
                 }
-                // The clock-accurate model must land where the planner said.
-                if ls.model.chain() != plan.final_state {
+                // The clock-accurate model must land where the planner said (with the cruise cut
+                // short after a controlled stop).
+                let played = u64::from(ls.model.outputs().tick_count);
+                let want = match plan.cruise_segment {
+                    Some(c) if played < plan.ticks_total() => {
+                        let mut p = plan.program.clone();
+                        p.segments[c].ticks -= (plan.ticks_total() - played) as u32;
+                        plan.start.run_program(&p, &plan.format.widths)
+                    }
+                    _ => plan.final_state,
+                };
+                if ls.model.chain() != want {
                     report.planner_disagreements += 1;
                 }
             }
@@ -574,6 +600,7 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
     for (r, res) in results {
         report.moves += r.moves;
         report.stopped += r.stopped;
+        report.soft_stopped += r.soft_stopped;
         report.skipped += r.skipped;
         report.clocks += r.clocks;
         report.ticks += r.ticks;

@@ -10,7 +10,7 @@ use snapgen_model::{CoreInputs, CoreOutputs, Format};
 use crate::SimError;
 
 /// Input words per `set` call (must match the harness).
-pub const IN_WORDS: usize = 13;
+pub const IN_WORDS: usize = 15;
 /// Output words per clock (must match the harness).
 pub const OUT_WORDS: usize = 19;
 
@@ -114,6 +114,8 @@ impl Fabric {
             (snap >> 96) as u32,
             u32::from(i.count_enable),
             u32::from(i.count_value),
+            u32::from(i.cruise_value),
+            u32::from(i.soft_stop),
         ];
         // SAFETY: `handle` is a live instance; `words` has IN_WORDS words.
         unsafe { (self.set)(self.handle, words.as_ptr()) }

@@ -1,6 +1,7 @@
 //! Random move streams for co-simulation: positive and negative, tiny and long, every order,
 //! limits drawn log-uniformly so that each limit is the active one in some moves and phases
-//! are empty in others; a few moves run with a tick divider and a few are stopped midway.
+//! are empty in others; a few moves run with a tick divider, a few are aborted midway and a few
+//! get a controlled stop.
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -43,6 +44,8 @@ pub struct MoveSpec {
     pub tick_div: u32,
     /// Stop (abort) this many clocks after the start, if set.
     pub stop_after: Option<u64>,
+    /// Controlled stop this many clocks after the start, if set.
+    pub soft_stop_after: Option<u64>,
 }
 
 /// A deterministic stream of random moves.
@@ -127,11 +130,17 @@ impl MoveStream {
         } else {
             None
         };
+        let soft_stop_after = if stop_after.is_none() && r.gen_bool(0.05) {
+            Some(r.gen_range(1..20_000))
+        } else {
+            None
+        };
         MoveSpec {
             request: MoveRequest { distance, method },
             ts,
             tick_div,
             stop_after,
+            soft_stop_after,
         }
     }
 }

@@ -33,6 +33,8 @@ module top(
     input wire [{d}:0] write_snap,
     input wire count_enable,
     input wire [{ix}:0] count_value,
+    input wire [{ix}:0] cruise_value,
+    input wire soft_stop,
     output wire [{x}:0] x,
     output wire [{v}:0] v,
     output wire [{v}:0] a,
@@ -57,6 +59,8 @@ module top(
     reg [{d}:0] r_write_snap = {db}'d0;
     reg r_count_enable = 1'b0;
     reg [{ix}:0] r_count_value = {ixb}'d0;
+    reg [{ix}:0] r_cruise_value = {ixb}'d0;
+    reg r_soft_stop = 1'b0;
     always @(posedge clock) begin
         r_reset <= reset;
         r_tick_div <= tick_div;
@@ -68,12 +72,15 @@ module top(
         r_write_snap <= write_snap;
         r_count_enable <= count_enable;
         r_count_value <= count_value;
+        r_cruise_value <= cruise_value;
+        r_soft_stop <= soft_stop;
     end
     snapgen_core core(
         .clock(clock), .reset(r_reset), .tick_div(r_tick_div), .start(r_start), .stop(r_stop),
         .write_enable(r_write_enable), .write_address(r_write_address),
         .write_ticks(r_write_ticks), .write_snap(r_write_snap),
         .count_enable(r_count_enable), .count_value(r_count_value),
+        .cruise_value(r_cruise_value), .soft_stop(r_soft_stop),
         .x(x), .v(v), .a(a), .j(j), .position(position), .segment(segment), .busy(busy),
         .done(done), .aborted(aborted), .tick_count(tick_count), .tick(tick),
         .active_bank(active_bank), .standby_count(standby_count)

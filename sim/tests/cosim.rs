@@ -24,7 +24,8 @@ fn thousand_random_moves_match_bit_for_bit() {
     assert_eq!(r.planner_disagreements, 0);
     assert_eq!(r.moves, 1000);
     assert!(r.ticks >= 10_000_000, "only {} ticks", r.ticks);
-    assert!(r.stopped > 0, "no move was stopped midway");
+    assert!(r.stopped > 0, "no move was aborted midway");
+    assert!(r.soft_stopped > 0, "no move got a controlled stop");
 }
 
 #[test]

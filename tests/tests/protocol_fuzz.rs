@@ -96,7 +96,11 @@ fn corrupted_length_bytes_are_rejected() {
     let frames: Vec<Frame> = vec![
         Command::Ping.to_frame(1, f),
         Command::Start.to_frame(2, f),
-        Command::Commit { count: 15 }.to_frame(3, f),
+        Command::Commit {
+            count: 15,
+            cruise: Some(7),
+        }
+        .to_frame(3, f),
         Command::LoadSegment {
             index: 2,
             segment: snapgen_model::Segment {

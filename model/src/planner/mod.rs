@@ -212,6 +212,9 @@ pub struct Plan {
     pub program: Program,
     /// Seed 001 values (duration method only).
     pub duration_values: Option<DurationValues>,
+    /// Index of the cruise segment (constant velocity, jerk and acceleration zero), if the
+    /// move has one: a controlled stop ends it early and decelerates as planned.
+    pub cruise_segment: Option<usize>,
 }
 
 impl Plan {
@@ -385,6 +388,7 @@ pub fn plan_from(
         peaks: Peaks::default(),
         program: Program::empty(),
         duration_values: None,
+        cruise_segment: None,
     };
     if let Method::Duration {
         duration,
@@ -613,6 +617,8 @@ fn quantize_into(
         let k = i128::try_from(k).expect("k ≤ k_lim ≤ register max");
         let amp = sign * k;
         let program = unit.pieces.to_program(amp);
+        plan.cruise_segment =
+            quantize::Pieces::cruise_segment(&program, quantize::cruise_end(shape, &phases));
         program.validate(&f)?;
         // The chain is linear and starts at rest, so the move's peaks are |K| times the unit
         // peaks, exactly; the position is monotonic, so its extremes are the two ends.

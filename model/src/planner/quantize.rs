@@ -63,6 +63,22 @@ impl Pieces {
         &self.items[..self.len]
     }
 
+    /// Index of the segment of `program` (built by [`Pieces::to_program`]) that is the cruise:
+    /// the zero-snap segment that ends at tick `cruise_end`, if there is one.
+    pub fn cruise_segment(program: &Program, cruise_end: u64) -> Option<usize> {
+        let mut end = 0u64;
+        for (i, s) in program.segments.iter().enumerate() {
+            end += u64::from(s.ticks);
+            if end == cruise_end {
+                return (s.snap == 0).then_some(i);
+            }
+            if end > cruise_end {
+                return None;
+            }
+        }
+        None
+    }
+
     /// The program with amplitude `k`: empty pieces dropped, equal neighbours joined.
     pub fn to_program(&self, k: i128) -> Program {
         let mut out: Vec<Segment> = Vec::with_capacity(self.len);
@@ -170,6 +186,17 @@ fn unit_pieces(shape: Shape, p: &PhaseTicks) -> Pieces {
 /// The program of `shape` with amplitude 1 and the given phase ticks.
 pub fn unit_program(shape: Shape, p: &PhaseTicks) -> Program {
     unit_pieces(shape, p).to_program(1)
+}
+
+/// The tick at which the cruise of a unit program of `shape` ends (where deceleration starts):
+/// between the end of the acceleration half, where jerk, acceleration and the snap are zero,
+/// and this tick, the velocity is constant.
+pub fn cruise_end(shape: Shape, p: &PhaseTicks) -> u64 {
+    match shape {
+        Shape::Snap4 => 4 * p.d + 2 * p.j + p.a + p.v,
+        Shape::Jerk3 => 2 * p.j + p.a + p.v,
+        Shape::Accel2 => p.a + p.v,
+    }
 }
 
 /// The total ticks of a unit program of `shape`, without building it.
