@@ -2,7 +2,7 @@
 //! decoder and the PWM generator (what a board top instantiates; `snapgen verilog --top io`).
 //!
 //! ```text
-//! uart_rx → UartRx → FrameRx → Executor → MotionCore
+//! uart_rx → UartRx → ByteFifo → FrameRx → Executor → MotionCore
 //!                                  │          │ status
 //! uart_tx ← UartTx ← ByteFifo ← ReplyTx ←─────┘
 //! enc_a/b/i → QuadratureDecoder → encoder count (status, PWM)
@@ -87,8 +87,9 @@ pub struct IoTop {
     core: MotionCore,
     replies: ReplyTx,
     fifo: ByteFifo,
+    rx_fifo: ByteFifo,
     uart_out: UartTx,
-    encoder: QuadratureDecoder,
+    encoder: QuadratureDecoder<32>,
     pwm_gen: PwmGenerator,
     heartbeat: DFF<Bits<32>>,
     error: Signal<Local, Bits<32>>,
@@ -134,6 +135,7 @@ impl IoTop {
             core: Default::default(),
             replies: Default::default(),
             fifo: Default::default(),
+            rx_fifo: Default::default(),
             uart_out: Default::default(),
             encoder: Default::default(),
             pwm_gen: Default::default(),
@@ -168,15 +170,22 @@ impl Default for IoTop {
 impl Logic for IoTop {
     #[hdl_gen]
     fn update(&mut self) {
-        clock!(self, clock, uart_in, frames, exec, core, replies, fifo, uart_out, encoder, pwm_gen);
+        clock!(
+            self, clock, uart_in, rx_fifo, frames, exec, core, replies, fifo, uart_out, encoder,
+            pwm_gen
+        );
         dff_setup!(self, clock, heartbeat);
         self.heartbeat.d.next = self.heartbeat.q.val() + self.one.val();
         // Receive path.
         self.uart_in.rx.next = self.uart_rx.val();
         self.uart_in.divisor.next = self.divisor.val();
         self.frames.reset.next = self.reset.val();
-        self.frames.data.next = self.uart_in.data.val();
-        self.frames.valid.next = self.uart_in.valid.val();
+        // Received bytes pass through a small FIFO; the frame receiver takes one per clock.
+        self.rx_fifo.write.next = self.uart_in.valid.val();
+        self.rx_fifo.write_data.next = self.uart_in.data.val();
+        self.rx_fifo.read.next = !self.rx_fifo.empty.val();
+        self.frames.data.next = self.rx_fifo.data.val();
+        self.frames.valid.next = !self.rx_fifo.empty.val();
         self.frames.line_error.next = self.uart_in.framing_error.val();
         self.frames.timeout.next = self.timeout.val();
         // Executor.

@@ -1,5 +1,5 @@
 //! Quadrature encoder decoder (model: `snapgen_model::io::quadrature`): filtered A, B and
-//! index, 4× decoding into a signed 32-bit count, a 16-bit counter of illegal double
+//! index, 4× decoding into a signed `N`-bit count, a 16-bit counter of illegal double
 //! transitions, and the count latched on each rising edge of the index.
 //!
 //! The decoder compares the filtered levels with their values one clock earlier. Gray order
@@ -11,9 +11,9 @@ use rust_hdl::prelude::*;
 
 use crate::input_filter::InputFilter;
 
-/// The decoder.
+/// The decoder, with an `N`-bit count.
 #[derive(LogicBlock)]
-pub struct QuadratureDecoder {
+pub struct QuadratureDecoder<const N: usize> {
     /// Fabric clock.
     pub clock: Signal<In, Clock>,
     /// Channel A pin.
@@ -27,11 +27,11 @@ pub struct QuadratureDecoder {
     /// Synchronous clear of the count, the errors and the index latch.
     pub clear: Signal<In, Bit>,
     /// Position count, two's complement.
-    pub count: Signal<Out, Bits<32>>,
+    pub count: Signal<Out, Bits<N>>,
     /// Illegal transitions (wraps).
     pub errors: Signal<Out, Bits<16>>,
     /// Count at the last index edge.
-    pub index_count: Signal<Out, Bits<32>>,
+    pub index_count: Signal<Out, Bits<N>>,
     /// An index edge was seen since the last clear.
     pub index_seen: Signal<Out, Bit>,
     fa: InputFilter,
@@ -40,17 +40,17 @@ pub struct QuadratureDecoder {
     prev_a: DFF<Bit>,
     prev_b: DFF<Bit>,
     prev_z: DFF<Bit>,
-    count_reg: DFF<Bits<32>>,
+    count_reg: DFF<Bits<N>>,
     errors_reg: DFF<Bits<16>>,
-    index_count_reg: DFF<Bits<32>>,
+    index_count_reg: DFF<Bits<N>>,
     index_seen_reg: DFF<Bit>,
-    count_one: Constant<Bits<32>>,
-    count_zero: Constant<Bits<32>>,
+    count_one: Constant<Bits<N>>,
+    count_zero: Constant<Bits<N>>,
     errors_one: Constant<Bits<16>>,
     errors_zero: Constant<Bits<16>>,
 }
 
-impl Default for QuadratureDecoder {
+impl<const N: usize> Default for QuadratureDecoder<N> {
     fn default() -> Self {
         QuadratureDecoder {
             clock: Default::default(),
@@ -81,7 +81,7 @@ impl Default for QuadratureDecoder {
     }
 }
 
-impl Logic for QuadratureDecoder {
+impl<const N: usize> Logic for QuadratureDecoder<N> {
     #[hdl_gen]
     fn update(&mut self) {
         clock!(self, clock, fa, fb, fz);
@@ -144,7 +144,7 @@ mod tests {
 
     #[test]
     fn quadrature_decoder_is_synthesizable() {
-        let mut uut = QuadratureDecoder::default();
+        let mut uut = QuadratureDecoder::<32>::default();
         uut.connect_all();
         let v = crate::verilog::direct_clocks(&generate_verilog(&uut));
         yosys_validate("quadrature", &v).unwrap();

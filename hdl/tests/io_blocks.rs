@@ -99,12 +99,14 @@ fn encoder_stimulus(seed: u64, clocks: usize) -> Vec<QuadInputs> {
 fn quadrature_decoder_matches_the_model() {
     let stimulus = encoder_stimulus(0x5eed_0001, 20_000);
     let mut sim = Simulation::new();
-    sim.add_clock(5, |x: &mut Box<QuadratureDecoder>| {
+    // A 6-bit count, so that the random walk also reaches its ends and wraps.
+    sim.add_clock(5, |x: &mut Box<QuadratureDecoder<6>>| {
         x.clock.next = !x.clock.val()
     });
-    sim.add_testbench(move |mut sim: Sim<QuadratureDecoder>| {
+    sim.add_testbench(move |mut sim: Sim<QuadratureDecoder<6>>| {
         let mut x = sim.init()?;
-        let mut m = Quadrature::new();
+        let mut m = Quadrature::with_width(6);
+        let mut wrapped = false;
         let (mut steps, mut errors) = (0u64, 0u64);
         for i in &stimulus {
             x.a.next = i.a;
@@ -114,23 +116,24 @@ fn quadrature_decoder_matches_the_model() {
             x.clear.next = i.clear;
             wait_clock_cycle!(sim, clock, x);
             let o = m.clock(i);
-            sim_assert_eq!(sim, x.count.val().to_u64() as u32 as i32, o.count, x);
+            sim_assert_eq!(sim, (x.count.val().to_u64() as i64) << 58 >> 58, o.count, x);
+            wrapped |= o.count == -32;
             sim_assert_eq!(sim, x.errors.val().to_u64() as u16, o.errors, x);
             sim_assert_eq!(
                 sim,
-                x.index_count.val().to_u64() as u32 as i32,
+                (x.index_count.val().to_u64() as i64) << 58 >> 58,
                 o.index_count,
                 x
             );
             sim_assert_eq!(sim, x.index_seen.val(), o.index_seen, x);
-            steps = steps.max(o.count.unsigned_abs().into());
+            steps = steps.max(o.count.unsigned_abs());
             errors = errors.max(o.errors.into());
         }
         // The stimulus exercised counting and errors.
-        sim_assert!(sim, steps > 10 && errors > 0, x);
+        sim_assert!(sim, steps > 10 && errors > 0 && wrapped, x);
         sim.done(x)
     });
-    let mut uut = QuadratureDecoder::default();
+    let mut uut = QuadratureDecoder::<6>::default();
     uut.connect_all();
     sim.run(Box::new(uut), 1_000_000_000).unwrap();
 }

@@ -33,7 +33,7 @@ fn every_block_lints_clean() {
     lint("motion_core", snapgen_hdl::core::MotionCore::default());
     lint(
         "quadrature",
-        snapgen_hdl::quadrature::QuadratureDecoder::default(),
+        snapgen_hdl::quadrature::QuadratureDecoder::<32>::default(),
     );
     lint("pwm", snapgen_hdl::pwm::PwmGenerator::default());
     lint("uart_rx", snapgen_hdl::uart_rx::UartRx::default());

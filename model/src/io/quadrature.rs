@@ -1,5 +1,6 @@
 //! Quadrature encoder decoder: two-flop synchronisers, a programmable glitch filter on A, B and
-//! the index, 4× decoding into a signed 32-bit count, and a counter of illegal double
+//! the index, 4× decoding into a signed count of configurable width (wrapping at it, as the
+//! hardware register does), and a counter of illegal double
 //! transitions (both channels changing on the same clock, after filtering).
 //!
 //! Direction: the filtered state `(A, B)` read as Gray code 00 → 01 → 11 → 10 → 00 counts up
@@ -25,18 +26,18 @@ pub struct QuadInputs {
 /// Outputs after a clock edge.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct QuadOutputs {
-    /// Position count (4 per line).
-    pub count: i32,
+    /// Position count (4 per line), sign-extended from the counter's width.
+    pub count: i64,
     /// Illegal transitions seen (wraps at 2^16).
     pub errors: u16,
     /// The count latched at the last rising edge of the index (as it stood before that clock).
-    pub index_count: i32,
+    pub index_count: i64,
     /// An index edge was seen since the last clear.
     pub index_seen: bool,
 }
 
 /// The decoder.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Quadrature {
     a: FilteredInput,
     b: FilteredInput,
@@ -46,6 +47,13 @@ pub struct Quadrature {
     prev_b: bool,
     prev_z: bool,
     out: QuadOutputs,
+    bits: u32,
+}
+
+impl Default for Quadrature {
+    fn default() -> Self {
+        Quadrature::with_width(32)
+    }
 }
 
 /// Gray code to position within a cycle: 00 → 0, 01 → 1, 11 → 2, 10 → 3.
@@ -59,9 +67,27 @@ fn phase(a: bool, b: bool) -> u8 {
 }
 
 impl Quadrature {
-    /// A decoder whose inputs rest low.
+    /// A decoder whose inputs rest low, with a 32-bit count.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A decoder with a `bits`-wide count (2..=64).
+    pub fn with_width(bits: u32) -> Self {
+        assert!(
+            (2..=64).contains(&bits),
+            "count width {bits} outside 2..=64"
+        );
+        Quadrature {
+            a: Default::default(),
+            b: Default::default(),
+            z: Default::default(),
+            prev_a: false,
+            prev_b: false,
+            prev_z: false,
+            out: QuadOutputs::default(),
+            bits,
+        }
     }
 
     /// One clock.
@@ -79,8 +105,8 @@ impl Quadrature {
                 o.index_seen = true;
             }
             match new.wrapping_sub(old) & 3 {
-                1 => o.count = o.count.wrapping_add(1),
-                3 => o.count = o.count.wrapping_sub(1),
+                1 => o.count = wrap(o.count.wrapping_add(1), self.bits),
+                3 => o.count = wrap(o.count.wrapping_sub(1), self.bits),
                 2 => o.errors = o.errors.wrapping_add(1),
                 _ => {}
             }
@@ -93,6 +119,12 @@ impl Quadrature {
         self.z.clock(i.index, i.filter);
         self.out
     }
+}
+
+/// Sign-extends the low `bits` bits.
+fn wrap(v: i64, bits: u32) -> i64 {
+    let s = 64 - bits;
+    (v << s) >> s
 }
 
 #[cfg(test)]
