@@ -103,6 +103,34 @@ proptest! {
         prop_assert_eq!(&serde_json::from_str::<Program>(&json).unwrap(), &p.program);
     }
 
+    /// The segment a controlled stop may shorten is a true cruise: it starts with jerk and
+    /// acceleration at zero (so cutting it after any number of its ticks still ends the move
+    /// at rest, exactly), and a profile with a long enough constant-velocity phase has one.
+    #[test]
+    fn a_controlled_stop_only_cuts_a_cruise(m in method(), x in distance(), f in format(), cut in 0.0f64..1.0) {
+        let p = try_plan(&MoveRequest { distance: x, method: m }, &f)?;
+        let w = &p.format.widths;
+        match p.cruise_segment {
+            Some(c) => {
+                let before = Program { segments: p.program.segments[..c].to_vec() };
+                let at = p.start.run_program(&before, w);
+                prop_assert_eq!(p.program.segments[c].snap, 0);
+                prop_assert_eq!((at.a, at.j), (0, 0), "segment {} of {:?}", c, p.program);
+                prop_assert!(at.v != 0);
+                let mut short = p.program.clone();
+                let keep = 1 + (cut * f64::from(short.segments[c].ticks - 1)) as u32;
+                short.segments[c].ticks = keep;
+                prop_assert!(p.start.run_program(&short, w).is_at_rest());
+            }
+            // One-tick impulses (orders 2, 3) or snap pieces (order 4) bound the cruise:
+            // three ticks of constant velocity always make a cuttable segment.
+            None => prop_assert!(
+                p.phases.v < 3,
+                "no cruise segment in {:?} (phases {:?})", p.program, p.phases
+            ),
+        }
+    }
+
     /// The move of −x is the move of +x with every snap negated, and ends at the mirrored
     /// register value, bit for bit.
     #[test]

@@ -618,7 +618,7 @@ fn quantize_into(
         let amp = sign * k;
         let program = unit.pieces.to_program(amp);
         plan.cruise_segment =
-            quantize::Pieces::cruise_segment(&program, quantize::cruise_end(shape, &phases));
+            quantize::Pieces::cruise_segment(&program, quantize::cruise_ticks(shape, &phases));
         program.validate(&f)?;
         // The chain is linear and starts at rest, so the move's peaks are |K| times the unit
         // peaks, exactly; the position is monotonic, so its extremes are the two ends.

@@ -20,6 +20,8 @@
 //! Because the unit program's accel and decel halves cancel, jerk, acceleration and velocity
 //! end at exactly 0 for every amplitude.
 
+use core::ops::Range;
+
 use ethnum::I256;
 
 use super::PhaseTicks;
@@ -64,15 +66,19 @@ impl Pieces {
     }
 
     /// Index of the segment of `program` (built by [`Pieces::to_program`]) that is the cruise:
-    /// the zero-snap segment that ends at tick `cruise_end`, if there is one.
-    pub fn cruise_segment(program: &Program, cruise_end: u64) -> Option<usize> {
+    /// the zero-snap segment lying inside `cruise` (ticks from the program start, half-open)
+    /// and ending at its end, if there is one. A zero-snap segment that begins before the
+    /// cruise (an acceleration plateau joined to it, or a triangular profile with no cruise at
+    /// all) is not a cruise: cutting it would leave the axis moving.
+    pub fn cruise_segment(program: &Program, cruise: Range<u64>) -> Option<usize> {
         let mut end = 0u64;
         for (i, s) in program.segments.iter().enumerate() {
+            let start = end;
             end += u64::from(s.ticks);
-            if end == cruise_end {
-                return (s.snap == 0).then_some(i);
+            if end == cruise.end {
+                return (s.snap == 0 && start >= cruise.start && start < end).then_some(i);
             }
-            if end > cruise_end {
+            if end > cruise.end {
                 return None;
             }
         }
@@ -188,15 +194,20 @@ pub fn unit_program(shape: Shape, p: &PhaseTicks) -> Program {
     unit_pieces(shape, p).to_program(1)
 }
 
-/// The tick at which the cruise of a unit program of `shape` ends (where deceleration starts):
-/// between the end of the acceleration half, where jerk, acceleration and the snap are zero,
-/// and this tick, the velocity is constant.
-pub fn cruise_end(shape: Shape, p: &PhaseTicks) -> u64 {
-    match shape {
-        Shape::Snap4 => 4 * p.d + 2 * p.j + p.a + p.v,
-        Shape::Jerk3 => 2 * p.j + p.a + p.v,
-        Shape::Accel2 => p.a + p.v,
-    }
+/// The ticks of a unit program of `shape` during which the velocity is constant and jerk,
+/// acceleration and snap are zero (half-open, from the program start): from the end of the
+/// acceleration half (after its last snap piece or impulse) to where deceleration starts.
+/// Empty when the profile has no cruise.
+pub fn cruise_ticks(shape: Shape, p: &PhaseTicks) -> Range<u64> {
+    let (start, end) = match shape {
+        // Eq 63: the acceleration half is 4·T_d + 2·T_j + T_a ticks of pieces.
+        Shape::Snap4 => (4 * p.d + 2 * p.j + p.a, 4 * p.d + 2 * p.j + p.a + p.v),
+        // The jerk impulse at tick 2·T_j + T_a ends the acceleration half.
+        Shape::Jerk3 => (2 * p.j + p.a + 1, 2 * p.j + p.a + p.v),
+        // The acceleration step back to zero is the impulse pair at T_a, T_a + 1.
+        Shape::Accel2 => (p.a + 2, p.a + p.v),
+    };
+    start..end.max(start)
 }
 
 /// The total ticks of a unit program of `shape`, without building it.
