@@ -116,22 +116,6 @@ pub struct SendOptions {
     pub stop_after: Option<Duration>,
 }
 
-/// Where the move ends after `played` ticks: the plan's end, or — after a controlled stop, which
-/// cuts the cruise short — the same program with a shorter cruise.
-pub fn expected_end(plan: &Plan, start: ChainState, played: u32) -> ChainState {
-    let total = plan.ticks_total();
-    let played = u64::from(played);
-    match plan.cruise_segment {
-        Some(c) if played < total => {
-            let mut p = plan.program.clone();
-            let cut = (total - played).min(u64::from(p.segments[c].ticks) - 1);
-            p.segments[c].ticks -= cut as u32;
-            start.run_program(&p, &plan.format.widths)
-        }
-        _ => plan.final_state,
-    }
-}
-
 /// The outcome of a move.
 #[derive(Clone, Debug)]
 pub struct SendReport {
@@ -444,7 +428,7 @@ pub fn send(
         tick_count: status.tick_count,
         ..last
     };
-    let want = expected_end(&plan, ChainState::at_rest(x0), status.tick_count);
+    let want = plan.end_after(u64::from(status.tick_count));
     if x != want.x {
         return Err(SendError::WrongEnd {
             got: x,

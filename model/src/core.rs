@@ -410,6 +410,7 @@ mod tests {
         let want = ChainState::at_rest(f.home_raw()).run_program(&short, &f.widths);
         assert!(played < p.ticks_total());
         assert_eq!(m.chain(), want);
+        assert_eq!(p.end_after(played), want);
         assert!(m.chain().is_at_rest());
     }
 

@@ -515,15 +515,7 @@ fn session(
                 }
                 // The clock-accurate model must land where the planner said (with the cruise cut
                 // short after a controlled stop).
-                let played = u64::from(ls.model.outputs().tick_count);
-                let want = match plan.cruise_segment {
-                    Some(c) if played < plan.ticks_total() => {
-                        let mut p = plan.program.clone();
-                        p.segments[c].ticks -= (plan.ticks_total() - played) as u32;
-                        plan.start.run_program(&p, &plan.format.widths)
-                    }
-                    _ => plan.final_state,
-                };
+                let want = plan.end_after(u64::from(ls.model.outputs().tick_count));
                 if ls.model.chain() != want {
                     report.planner_disagreements += 1;
                 }

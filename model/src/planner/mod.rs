@@ -228,6 +228,22 @@ impl Plan {
         self.program.total_ticks()
     }
 
+    /// Where the move stands when the sequencer finishes after `played` ticks: the planned end,
+    /// or — after a controlled stop, which cuts the cruise short (the fabric always plays at
+    /// least one cruise tick) — the same program with that many fewer cruise ticks.
+    pub fn end_after(&self, played: u64) -> ChainState {
+        let total = self.ticks_total();
+        match self.cruise_segment {
+            Some(c) if played < total => {
+                let mut p = self.program.clone();
+                let cut = (total - played).min(u64::from(p.segments[c].ticks) - 1);
+                p.segments[c].ticks -= cut as u32;
+                self.start.run_program(&p, &self.format.widths)
+            }
+            _ => self.final_state,
+        }
+    }
+
     /// Duration in seconds.
     pub fn duration_s(&self) -> f64 {
         self.ticks_total() as f64 * self.format.ts
