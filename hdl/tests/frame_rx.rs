@@ -8,6 +8,9 @@ use snapgen_hdl::frame_rx::FrameRx;
 use snapgen_model::protocol::{Command, Decoded, Decoder, Frame, Param};
 use snapgen_model::{Segment, DEFAULT_FORMAT};
 
+mod common;
+use common::Rng;
+
 const TIMEOUT: u64 = 20;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -20,19 +23,6 @@ enum Event {
     },
     BadCrc,
     Dropped,
-}
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
 }
 
 fn le(b: &[u8]) -> u128 {

@@ -15,24 +15,8 @@ use snapgen_model::io::pwm::{Pwm, PwmInputs};
 use snapgen_model::io::quadrature::{QuadInputs, Quadrature};
 use snapgen_model::io::uart::{UartRx as RxModel, UartTx as TxModel};
 
-/// A small deterministic generator (xorshift64*), so the stimulus is the same on every run.
-#[derive(Clone)]
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn chance(&mut self, percent: u64) -> bool {
-        self.below(100) < percent
-    }
-}
+mod common;
+use common::Rng;
 
 fn b16(v: u16) -> Bits<16> {
     u64::from(v).into()
