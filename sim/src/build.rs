@@ -1,13 +1,22 @@
 //! Builds the Verilated core into a shared library, through the Verilator CLI:
 //!
 //! ```text
-//! verilator --cc --exe --build -O3 -Wall --top-module top verilator.vlt top.v harness.cpp
-//!           -CFLAGS "-fPIC -O2 -DSNAPGEN_TRACE=0|1" -LDFLAGS -shared -o libsnapgen_core.so
+//! verilator --cc --exe --build -O3 -Wall --x-assign fast --x-initial fast --noassert
+//!           --top-module top verilator.vlt top.v harness.cpp
+//!           -CFLAGS "-fPIC -march=native -fno-semantic-interposition -DSNAPGEN_TRACE=0|1"
+//!           -MAKEFLAGS "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3"
+//!           -LDFLAGS "-shared -Wl,-Bsymbolic" -o libsnapgen_core.so
 //! ```
+//!
+//! The C++ optimisation level must go through `OPT_FAST`/`OPT_GLOBAL`: Verilator's makefile
+//! appends its default `-Os` after `-CFLAGS`, so an `-O3` there is silently overridden (measured:
+//! 80 ns per clock at `-Os`, 38 ns at `-O3`). `-fno-semantic-interposition` and `-Bsymbolic` let
+//! the compiler inline and call Verilator's runtime helpers directly instead of through the PLT
+//! of the shared library. `-march=native` is safe because the cache is per machine.
 //!
 //! Builds are cached in `$SNAPGEN_CACHE_DIR` (default `$XDG_CACHE_HOME/snapgen` or
 //! `~/.cache/snapgen`) under a hash of the Verilog, the waivers, the harness, the Verilator
-//! version and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
+//! version, these flags and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
 //! warning that the waiver file does not waive fatal, so a build is also a lint check.
 //! `$SNAPGEN_VERILATOR` overrides the `verilator` binary.
 
@@ -23,6 +32,13 @@ pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
 pub const IO_HARNESS_CPP: &str = include_str!("../harness/io_harness.cpp");
 /// The Verilator waiver file for the generated core.
 pub const WAIVERS_VLT: &str = include_str!("../../hdl/verilator.vlt");
+
+/// C++ flags of every build (see the module documentation).
+const CFLAGS: &str = "-fPIC -march=native -fno-semantic-interposition";
+/// Verilator makefile variables: the optimisation levels it would otherwise set to `-Os`.
+const MAKEFLAGS: &str = "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3";
+/// Link flags: a shared library whose internal calls bind locally.
+const LDFLAGS: &str = "-shared -Wl,-Bsymbolic";
 
 /// The Verilator binary to use.
 pub fn verilator_bin() -> String {
@@ -119,6 +135,9 @@ fn build_with(
         WAIVERS_VLT.as_bytes(),
         harness.as_bytes(),
         version.as_bytes(),
+        CFLAGS.as_bytes(),
+        MAKEFLAGS.as_bytes(),
+        LDFLAGS.as_bytes(),
         &[u8::from(trace)],
     ]);
     let root = cache_root();
@@ -158,12 +177,10 @@ fn build_with(
         .args(["--top-module", "top", "--Mdir", "obj"])
         .args([
             "-CFLAGS",
-            &format!(
-                "-fPIC -O3 -march=native -DSNAPGEN_TRACE={}",
-                u8::from(trace)
-            ),
+            &format!("{CFLAGS} -DSNAPGEN_TRACE={}", u8::from(trace)),
         ])
-        .args(["-LDFLAGS", "-shared", "-o", "libsnapgen_core.so"]);
+        .args(["-MAKEFLAGS", MAKEFLAGS])
+        .args(["-LDFLAGS", LDFLAGS, "-o", "libsnapgen_core.so"]);
     if trace {
         cmd.arg("--trace");
     }
