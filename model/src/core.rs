@@ -149,6 +149,13 @@ impl CoreModel {
     /// One rising clock edge with inputs `i`; returns the outputs after it.
     #[inline]
     pub fn clock(&mut self, i: &CoreInputs) -> CoreOutputs {
+        self.edge(i);
+        self.outputs()
+    }
+
+    /// One rising clock edge with inputs `i` (read the outputs with [`CoreModel::outputs`]).
+    #[inline]
+    pub fn edge(&mut self, i: &CoreInputs) {
         let w = self.widths;
         // Combinational values before the edge.
         let tick = self.divider >= i.tick_div;
@@ -258,7 +265,6 @@ impl CoreModel {
         }
 
         self.tick_div = i.tick_div;
-        self.outputs()
     }
 
     /// Changes the `tick_div` input between edges (the combinational `tick` output follows it
