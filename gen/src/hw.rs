@@ -54,9 +54,11 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
         if r.cached_build { " (cached Verilator build)" } else { "" }
     );
     println!(
-        "throughput: {:.1} M ticks/s ({:.3} s)",
+        "throughput: {:.1} M ticks/s, {:.1} M clocks/s ({:.3} s, {})",
         r.ticks_per_second() / 1e6,
-        r.seconds
+        r.clocks as f64 / r.seconds.max(1e-9) / 1e6,
+        r.seconds,
+        count(r.threads, "thread")
     );
     if let Some(m) = &r.mismatch {
         println!("{m}");
@@ -70,13 +72,74 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     if let Some(v) = &r.vcd {
         println!("waves: {}", v.display());
     }
-    if bench {
-        let m = cosim::run_model_only(cfg);
-        println!(
-            "model alone: {:.1} M ticks/s; co-sim / model throughput ratio: {:.3}",
-            m.ticks_per_second() / 1e6,
-            r.ticks_per_second() / m.ticks_per_second()
-        );
+    if bench && r.mismatch.is_none() {
+        print_bench(&verilog, cfg, &r)?;
     }
     Ok(r)
+}
+
+/// Timed runs of the benchmark: the co-simulation and the model alone, each [`BENCH_RUNS`]
+/// times over the same moves.
+const BENCH_RUNS: usize = 5;
+
+/// Repeats the co-simulation and the model-only run and prints medians and bests: one run is
+/// at the mercy of whatever else the machine does (seen here: ±20 % between runs).
+fn print_bench(verilog: &str, cfg: &CosimConfig, first: &CosimReport) -> anyhow::Result<()> {
+    let quiet = CosimConfig {
+        progress: false,
+        ..cfg.clone()
+    };
+    let mut cosim_tps = vec![first.ticks_per_second()];
+    for _ in 1..BENCH_RUNS {
+        let again = cosim::run(verilog, &quiet)?;
+        if let Some(m) = again.mismatch {
+            anyhow::bail!("a repeated benchmark run mismatched: {m}");
+        }
+        cosim_tps.push(again.ticks_per_second());
+    }
+    let model_tps: Vec<f64> = (0..BENCH_RUNS)
+        .map(|_| cosim::run_model_only(&quiet).ticks_per_second())
+        .collect();
+    let threads = first.threads.max(1) as f64;
+    let (c_med, c_best) = (median(&cosim_tps), max(&cosim_tps));
+    let (m_med, m_best) = (median(&model_tps), max(&model_tps));
+    println!(
+        "bench, co-simulation, {BENCH_RUNS} runs: median {:.1}, best {:.1} M ticks/s ({} on {}; {:.1} M ticks/s per thread, median)",
+        c_med / 1e6,
+        c_best / 1e6,
+        count(cfg.sessions().len(), "session"),
+        count(first.threads, "thread"),
+        c_med / threads / 1e6
+    );
+    println!(
+        "bench, model alone (one thread, same moves), {BENCH_RUNS} runs: median {:.1}, best {:.1} M ticks/s",
+        m_med / 1e6,
+        m_best / 1e6
+    );
+    println!(
+        "bench, co-sim / model throughput ratio (medians): {:.3} all threads, {:.3} per thread",
+        c_med / m_med,
+        c_med / threads / m_med
+    );
+    Ok(())
+}
+
+/// "1 thread", "2 threads".
+fn count(n: usize, noun: &str) -> String {
+    format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
+}
+
+fn median(xs: &[f64]) -> f64 {
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+fn max(xs: &[f64]) -> f64 {
+    xs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
 }

@@ -86,9 +86,14 @@ enum Command {
         /// Where to write the waves around a mismatch.
         #[arg(long, default_value = "cosim-mismatch.vcd")]
         mismatch_vcd: PathBuf,
-        /// Also run the model alone and print the co-sim/model throughput ratio.
-        #[arg(long)]
+        /// Benchmark: repeat the run and the model alone 5 times each and print throughputs
+        /// (median, best) and the co-sim/model ratio.
+        #[arg(long, conflicts_with = "vcd")]
         bench: bool,
+        /// Sessions: each its own Verilated core, model and sub-stream of moves; they run on
+        /// one thread per core. The moves played depend on it [default: 16].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=256))]
+        sessions: Option<u16>,
         /// Test hook: flip BIT of REGISTER at CLOCK in the captured fabric stream
         /// ("CLOCK:REGISTER:BIT"), to show that a one-bit difference is reported.
         #[arg(long, hide = true)]
@@ -263,9 +268,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             vcd,
             mismatch_vcd,
             bench,
+            sessions,
             inject_fault,
         } => {
             let mut cfg = snapgen_sim::cosim::CosimConfig::new(moves, seed);
+            if let Some(n) = sessions {
+                cfg.session_count = usize::from(n);
+            }
             cfg.mix = order;
             cfg.vcd = vcd;
             cfg.mismatch_vcd = mismatch_vcd;

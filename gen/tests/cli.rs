@@ -394,3 +394,51 @@ fn verilog_is_lint_clean_under_wall() {
         }
     }
 }
+
+#[test]
+fn cosim_bench_prints_medians_and_the_ratio() {
+    let out = snapgen(&[
+        "cosim",
+        "--moves",
+        "12",
+        "--seed",
+        "3",
+        "--sessions",
+        "1",
+        "--bench",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains(", 0 mismatches"), "{stdout}");
+    // "... 5 runs: median A, best B M ticks/s ...": positive, best at least the median.
+    let numbers = |prefix: &str| -> (f64, f64) {
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no line {prefix:?} in {stdout}"));
+        let after = |key: &str| -> f64 {
+            let rest = &line[line.find(key).unwrap() + key.len()..];
+            rest.split([',', ' ']).next().unwrap().parse().unwrap()
+        };
+        (after("median "), after("best "))
+    };
+    for prefix in ["bench, co-simulation, 5 runs", "bench, model alone"] {
+        let (median, best) = numbers(prefix);
+        assert!(median > 0.0 && best >= median, "{prefix}: {stdout}");
+    }
+    assert!(
+        stdout.contains("bench, co-sim / model throughput ratio (medians): "),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn cosim_bench_refuses_waves() {
+    let out = snapgen(&["cosim", "--moves", "1", "--bench", "--vcd", "x.vcd"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--vcd"));
+}

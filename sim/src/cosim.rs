@@ -7,20 +7,29 @@
 //! compared after every rising edge. The first mismatch ends the session; it is then re-run
 //! with a trace build to write the waves around it.
 
+use std::collections::VecDeque;
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use snapgen_model::{plan_from, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT};
 
 use crate::build::build;
-use crate::fabric::{decode, encode, Fabric, VcdWindow, OUT_WORDS};
+use crate::fabric::{decode, Fabric, VcdWindow, OUT_WORDS};
 use crate::moves::{MoveSpec, MoveStream, OrderMix};
 use crate::SimError;
 
-/// Clocks per call into the fabric.
-const BATCH: u64 = 1 << 16;
+/// Clocks per call into the fabric: its output words (76 bytes a clock) stay in the L1/L2
+/// cache between the fabric writing and the comparison reading them (a 65 536-clock batch,
+/// 5 MB, did not).
+const BATCH: u64 = 1 << 9;
+/// Sessions a random run splits into unless told otherwise. Fixed, whatever the machine, so
+/// that a seed means the same moves everywhere; many more than cores, so that worker threads
+/// pulling sessions from a queue finish together even when one core is slower (seen here: the
+/// two cores of a shared machine differing by 20 %).
+pub const DEFAULT_SESSIONS: usize = 16;
 /// Longest move the stream keeps, in ticks (keeps CI runs bounded).
 const MAX_MOVE_TICKS: u64 = 400_000;
 
@@ -226,9 +235,9 @@ pub struct CosimConfig {
     pub progress: bool,
     /// Play these moves instead of a random stream (`moves` and `seed` are then ignored).
     pub fixed: Option<Vec<MoveSpec>>,
-    /// Parallel sessions for a random stream (each its own core, model and sub-stream);
-    /// 1 with `vcd` or `fixed`.
-    pub threads: usize,
+    /// Sessions of a random stream: each its own Verilated core, model and sub-stream of
+    /// moves; 1 with `vcd` or `fixed`. The moves played depend on it, not on the machine.
+    pub session_count: usize,
     /// Index of this session (set by `run`).
     pub session: usize,
 }
@@ -245,9 +254,7 @@ impl CosimConfig {
             fault: None,
             progress: true,
             fixed: None,
-            threads: std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(2),
+            session_count: DEFAULT_SESSIONS,
             session: 0,
         }
     }
@@ -259,7 +266,7 @@ impl CosimConfig {
         let n = if self.fixed.is_some() || self.vcd.is_some() {
             1
         } else {
-            self.threads.clamp(1, self.moves.max(1))
+            self.session_count.clamp(1, self.moves.max(1))
         };
         (0..n)
             .map(|s| CosimConfig {
@@ -270,7 +277,7 @@ impl CosimConfig {
                     self.seed ^ (s as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
                 },
                 fault: if s == 0 { self.fault } else { None },
-                threads: 1,
+                session_count: 1,
                 session: s,
                 ..self.clone()
             })
@@ -312,6 +319,8 @@ pub struct CosimReport {
     pub cached_build: bool,
     /// Moves after which the clock-accurate model did not stand where the planner said.
     pub planner_disagreements: usize,
+    /// Worker threads the sessions ran on (one per core, at most one per session).
+    pub threads: usize,
 }
 
 impl CosimReport {
@@ -334,6 +343,8 @@ struct Lockstep {
     /// Inputs of the previous clock: the fabric's wrapper registers every input, so the core
     /// sees them one clock late, and so does the model.
     pending: CoreInputs,
+    /// The chain steps with a program playing on the next clock (`tick && busy` now).
+    ticking: bool,
     session: usize,
 }
 
@@ -344,23 +355,26 @@ impl Lockstep {
         if let Some(fab) = self.fabric.as_mut() {
             fab.set(i);
         }
+        let masks = Masks::new(&f);
         let mut left = n;
         while left > 0 {
             let k = left.min(BATCH);
             match self.fabric.as_mut() {
                 Some(fab) => {
                     fab.run(k as usize, &mut self.buf);
-                    for c in 0..k as usize {
-                        let ticked = self.model.outputs().tick && self.model.busy();
-                        self.model.clock(&self.pending);
+                    for words in self.buf[..k as usize * OUT_WORDS].chunks_exact(OUT_WORDS) {
+                        let words: &[u32; OUT_WORDS] =
+                            words.try_into().expect("chunks of OUT_WORDS words");
+                        let ticked = self.ticking;
+                        self.model.edge(&self.pending);
                         // The registered tick_div already holds this clock's value, and the
                         // combinational `tick` output compares against it.
                         self.model.set_tick_div(i.tick_div);
                         let m = self.model.outputs();
+                        self.ticking = m.tick && m.busy;
                         self.pending = *i;
-                        let words = &self.buf[c * OUT_WORDS..(c + 1) * OUT_WORDS];
                         let faulty = self.fault.is_some_and(|fl| fl.clock == self.clock);
-                        if faulty || encode(&m, &f) != words {
+                        if faulty || differs(&m, words, &masks) {
                             let mut o = decode(words, &f);
                             if let Some(fl) = self.fault.filter(|_| faulty) {
                                 fl.register.flip(&mut o, fl.bit, &f);
@@ -391,8 +405,11 @@ impl Lockstep {
                 None => {
                     // Model only (the benchmark's reference).
                     for _ in 0..k {
-                        let ticked = self.model.outputs().tick && self.model.busy();
-                        std::hint::black_box(self.model.clock(&self.pending));
+                        let ticked = self.ticking;
+                        self.model.edge(&self.pending);
+                        self.model.set_tick_div(i.tick_div);
+                        let m = std::hint::black_box(self.model.outputs());
+                        self.ticking = m.tick && m.busy;
                         self.pending = *i;
                         self.ticks += u64::from(ticked);
                         self.clock += 1;
@@ -403,6 +420,51 @@ impl Lockstep {
         }
         Ok(())
     }
+}
+
+/// Masks of the wide registers: the fabric's words hold them zero-extended.
+struct Masks {
+    x: u128,
+    v: u128,
+    a: u128,
+    j: u128,
+}
+
+impl Masks {
+    fn new(f: &Format) -> Self {
+        let m = |bits: u32| u128::MAX >> (128 - bits);
+        Masks {
+            x: m(f.widths.x),
+            v: m(f.widths.v),
+            a: m(f.widths.a),
+            j: m(f.widths.j),
+        }
+    }
+}
+
+/// Whether the fabric's words differ from the model's outputs anywhere (the same layout as
+/// [`crate::fabric::encode`], compared without building it: every term OR-ed, no early exit).
+#[inline(always)]
+fn differs(m: &CoreOutputs, w: &[u32; OUT_WORDS], masks: &Masks) -> bool {
+    let wide = |k: usize| {
+        u128::from(w[k])
+            | (u128::from(w[k + 1]) << 32)
+            | (u128::from(w[k + 2]) << 64)
+            | (u128::from(w[k + 3]) << 96)
+    };
+    let flags = u32::from(m.segment)
+        | u32::from(m.busy) << 8
+        | u32::from(m.done) << 9
+        | u32::from(m.aborted) << 10
+        | u32::from(m.tick) << 11
+        | u32::from(m.active_bank) << 12
+        | u32::from(m.standby_count) << 16;
+    let wide_diff = ((m.x as u128 & masks.x) ^ wide(0))
+        | ((m.v as u128 & masks.v) ^ wide(4))
+        | ((m.a as u128 & masks.a) ^ wide(8))
+        | ((m.j as u128 & masks.j) ^ wide(12));
+    let narrow_diff = (m.position ^ w[16]) | (flags ^ w[17]) | (m.tick_count ^ w[18]);
+    wide_diff != 0 || narrow_diff != 0
 }
 
 /// Plays the session on `fabric` (or on the model alone when `None`).
@@ -423,6 +485,7 @@ fn session(
         fault: cfg.fault,
         move_index: 0,
         pending: CoreInputs::default(),
+        ticking: false,
         session: cfg.session,
     };
     let start_time = Instant::now();
@@ -547,8 +610,8 @@ fn progress_bar(cfg: &CosimConfig) -> ProgressBar {
     }
 }
 
-/// Runs a co-simulation of `verilog` (the motion core) against the model, in parallel
-/// sessions (see [`CosimConfig::sessions`]).
+/// Runs a co-simulation of `verilog` (the motion core) against the model: its sessions (see
+/// [`CosimConfig::sessions`]) on one worker thread per core.
 pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
     let built = build(verilog, cfg.vcd.is_some())?;
     let window = cfg.vcd.as_ref().map(|p| VcdWindow {
@@ -562,34 +625,48 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
         fabrics.push(Fabric::open(&built.library, window.as_ref())?);
     }
     let bar = progress_bar(cfg);
+    // One worker per core; each takes the next session from the queue until none is left.
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(sessions.len());
+    type Outcome = (CosimReport, Result<(), Mismatch>);
+    let queue: Mutex<VecDeque<(usize, Fabric)>> =
+        Mutex::new(fabrics.into_iter().enumerate().collect());
+    let outcomes: Mutex<Vec<Option<Outcome>>> = Mutex::new(vec![None; sessions.len()]);
     let wall = Instant::now();
-    let results: Vec<(CosimReport, Result<(), Mismatch>)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = sessions
-            .iter()
-            .zip(fabrics)
-            .map(|(s, fab)| {
-                let bar = bar.clone();
-                scope.spawn(move || {
-                    let mut r = CosimReport::default();
-                    let res = session(s, Some(fab), &mut r, &bar);
-                    (r, res)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a co-simulation session panicked"))
-            .collect()
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let next = queue.lock().unwrap_or_else(|e| e.into_inner()).pop_front();
+                let Some((k, fab)) = next else { break };
+                let mut r = CosimReport::default();
+                let res = session(&sessions[k], Some(fab), &mut r, &bar);
+                outcomes.lock().unwrap_or_else(|e| e.into_inner())[k] = Some((r, res));
+            });
+        }
     });
     bar.finish_and_clear();
     let mut report = CosimReport {
         cached_build: built.cached,
         vcd: cfg.vcd.clone(),
         seconds: wall.elapsed().as_secs_f64(),
+        threads,
         ..Default::default()
     };
     let mut first: Option<Mismatch> = None;
-    for (r, res) in results {
+    let outcomes = outcomes.into_inner().unwrap_or_else(|e| e.into_inner());
+    // A fault goes to session 0 and ends it with a mismatch once injected; a session 0 that
+    // ran clean never reached the fault's clock, and a clean report would mislead.
+    if let (Some(fault), Some((r0, Ok(())))) =
+        (cfg.fault, outcomes.first().and_then(|o| o.as_ref()))
+    {
+        return Err(SimError::FaultNotReached {
+            clock: fault.clock,
+            clocks: r0.clocks,
+        });
+    }
+    // Every session ran to its end or its first mismatch; the lowest session's is reported.
+    for (r, res) in outcomes.into_iter().flatten() {
         report.moves += r.moves;
         report.stopped += r.stopped;
         report.soft_stopped += r.soft_stopped;
@@ -631,8 +708,8 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
 }
 
 /// Runs the same sessions one after the other on the model alone (no fabric): the reference
-/// for the co-sim/model throughput ratio (single-threaded; divide by the session count for a
-/// per-core comparison).
+/// for the co-sim/model throughput ratio (single-threaded; divide the co-simulation's by its
+/// thread count for a per-core comparison).
 pub fn run_model_only(cfg: &CosimConfig) -> CosimReport {
     let mut report = CosimReport::default();
     let wall = Instant::now();
@@ -654,4 +731,69 @@ pub fn run_model_only(cfg: &CosimConfig) -> CosimReport {
     }
     report.seconds = wall.elapsed().as_secs_f64();
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fabric::encode;
+
+    /// Outputs with every field drawn from `seed` (registers wrapped to their widths).
+    fn outputs(seed: u64, f: &Format) -> CoreOutputs {
+        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut wide = |bits| {
+            let v = (u128::from(next()) << 64 | u128::from(next())) as i128;
+            snapgen_model::chain::wrap(v, bits)
+        };
+        let (x, v, a, j) = (
+            wide(f.widths.x),
+            wide(f.widths.v),
+            wide(f.widths.a),
+            wide(f.widths.j),
+        );
+        let r = next();
+        CoreOutputs {
+            x,
+            v,
+            a,
+            j,
+            position: r as u32,
+            segment: (r >> 32) as u8 & 0x3f,
+            busy: r >> 40 & 1 == 1,
+            done: r >> 41 & 1 == 1,
+            aborted: r >> 42 & 1 == 1,
+            tick_count: (r >> 16) as u32,
+            tick: r >> 43 & 1 == 1,
+            active_bank: r >> 44 & 1 == 1,
+            standby_count: (r >> 48) as u8 & 0x3f,
+        }
+    }
+
+    #[test]
+    fn the_comparison_sees_every_bit_of_every_word() {
+        let f = DEFAULT_FORMAT;
+        let masks = Masks::new(&f);
+        for seed in 0..64 {
+            let m = outputs(seed, &f);
+            let words = encode(&m, &f);
+            assert_eq!(decode(&words, &f), m, "layout round trip, seed {seed}");
+            assert!(!differs(&m, &words, &masks), "equal outputs, seed {seed}");
+            for k in 0..OUT_WORDS {
+                for bit in 0..32 {
+                    let mut bad = words;
+                    bad[k] ^= 1 << bit;
+                    assert!(
+                        differs(&m, &bad, &masks),
+                        "word {k} bit {bit} flipped unseen, seed {seed}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -136,8 +136,9 @@ impl Drop for Fabric {
     }
 }
 
-/// Encodes outputs in the harness's word layout (the inverse of [`decode`]): comparing words
-/// is cheaper than decoding the fabric's.
+/// Encodes outputs in the harness's word layout (the inverse of [`decode`]). The co-simulation
+/// compares the fabric's words against the model without building this array (its
+/// `differs`, tested against this function).
 #[inline]
 pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
     let mut w = [0u32; OUT_WORDS];

@@ -50,6 +50,17 @@ pub enum SimError {
         /// The error.
         source: std::io::Error,
     },
+    /// A deliberate fault (test hook) was asked for at a clock its session never reached.
+    #[error(
+        "the fault at clock {clock} was never injected: session 0 ran only {clocks} clocks; \
+         pick an earlier clock, more moves or fewer sessions"
+    )]
+    FaultNotReached {
+        /// The clock asked for.
+        clock: u64,
+        /// Clocks session 0 ran.
+        clocks: u64,
+    },
     /// The built library does not load or does not match this harness.
     #[error("cannot load the co-simulation library {path}: {reason}")]
     Load {

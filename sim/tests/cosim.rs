@@ -4,6 +4,7 @@
 use snapgen_sim::build::build;
 use snapgen_sim::cosim::{run, CosimConfig, Fault, Register};
 use snapgen_sim::moves::OrderMix;
+use snapgen_sim::SimError;
 
 fn verilog() -> String {
     snapgen_hdl::verilog::motion_core_verilog()
@@ -57,6 +58,8 @@ fn a_flipped_bit_is_reported_with_waves() {
         (9_000, Register::TickCount, 31),
     ] {
         let mut c = quiet(40, 5);
+        // The fault lands in session 0: two sessions give it 20 moves, long past these clocks.
+        c.session_count = 2;
         c.fault = Some(Fault {
             clock,
             register,
@@ -82,6 +85,24 @@ fn a_flipped_bit_is_reported_with_waves() {
             !vcd.contains("\n#3\n"),
             "dumped from the start, not a window"
         );
+    }
+}
+
+/// A fault past the end of its session is an error, not a clean report.
+#[test]
+fn a_fault_never_reached_is_an_error() {
+    let mut c = quiet(4, 5);
+    c.fault = Some(Fault {
+        clock: 1 << 40,
+        register: Register::X,
+        bit: 0,
+    });
+    match run(&verilog(), &c) {
+        Err(SimError::FaultNotReached { clock, clocks }) => {
+            assert_eq!(clock, 1 << 40);
+            assert!(clocks > 0 && clocks < clock);
+        }
+        other => panic!("expected FaultNotReached, got {other:?}"),
     }
 }
 
