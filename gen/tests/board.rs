@@ -203,9 +203,9 @@ fn corrupted_upload(fabric: bool) {
 #[test]
 fn a_silent_port_times_out() {
     // A pseudo-terminal with nobody serving it.
-    let pty = nix_free_pty();
+    let paused = paused_board();
     let out = send(
-        &pty,
+        &paused.port,
         &[
             "--order",
             "2",
@@ -227,17 +227,17 @@ fn a_silent_port_times_out() {
 }
 
 /// A board started and stopped at once leaves a pty path nobody answers on; a fresh board's
-/// path is used while it is paused instead: simplest, start one and SIGSTOP it.
-fn nix_free_pty() -> String {
+/// path is used while it is paused instead: simplest, start one and SIGSTOP it. The paused
+/// board is returned so that its drop kills it (SIGKILL ends a stopped process too) rather
+/// than leaving it behind after the test.
+fn paused_board() -> Board {
     let board = Board::start();
     let pid = board.child.id();
     Command::new("kill")
         .args(["-STOP", &pid.to_string()])
         .status()
         .unwrap();
-    let port = board.port.clone();
-    std::mem::forget(board);
-    port
+    board
 }
 
 #[test]
