@@ -12,11 +12,13 @@
 //! appends its default `-Os` after `-CFLAGS`, so an `-O3` there is silently overridden (measured:
 //! 80 ns per clock at `-Os`, 38 ns at `-O3`). `-fno-semantic-interposition` and `-Bsymbolic` let
 //! the compiler inline and call Verilator's runtime helpers directly instead of through the PLT
-//! of the shared library. `-march=native` is safe because the cache is per machine.
+//! of the shared library. `-march=native` builds for this CPU, so the CPU's identity (its
+//! `/proc/cpuinfo` model and flags) is part of the cache key: a cache directory shared with
+//! another machine never hands it a library its CPU cannot run.
 //!
 //! Builds are cached in `$SNAPGEN_CACHE_DIR` (default `$XDG_CACHE_HOME/snapgen` or
 //! `~/.cache/snapgen`) under a hash of the Verilog, the waivers, the harness, the Verilator
-//! version, these flags and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
+//! version, these flags, the CPU and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
 //! warning that the waiver file does not waive fatal, so a build is also a lint check.
 //! `$SNAPGEN_VERILATOR` overrides the `verilator` binary.
 
@@ -80,6 +82,19 @@ pub fn cache_root() -> PathBuf {
 }
 
 /// FNV-1a, 64 bit: a stable content hash for the cache key.
+/// What `-march=native` compiles for: the first `model name` and `flags` lines of
+/// `/proc/cpuinfo` (empty where there is no such file).
+fn host_cpu() -> String {
+    let info = fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let first = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == key))
+            .unwrap_or("")
+            .to_string()
+    };
+    format!("{}\n{}", first("model name"), first("flags"))
+}
+
 fn fnv1a(parts: &[&[u8]]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for p in parts {
@@ -136,6 +151,7 @@ fn build_with(
         harness.as_bytes(),
         version.as_bytes(),
         CFLAGS.as_bytes(),
+        host_cpu().as_bytes(),
         MAKEFLAGS.as_bytes(),
         LDFLAGS.as_bytes(),
         &[u8::from(trace)],
