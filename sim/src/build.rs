@@ -18,8 +18,9 @@
 //!
 //! Builds are cached in `$SNAPGEN_CACHE_DIR` (default `$XDG_CACHE_HOME/snapgen` or
 //! `~/.cache/snapgen`) under a hash of the Verilog, the waivers, the harness, the Verilator
-//! version, these flags, the CPU and the trace flag: an unchanged design never rebuilds. `-Wall` makes every lint
-//! warning that the waiver file does not waive fatal, so a build is also a lint check.
+//! version, these flags, the CPU and the trace flag: an unchanged design never rebuilds.
+//! `-Wall` makes every lint warning that the waiver file does not waive fatal, so a build is
+//! also a lint check.
 //! `$SNAPGEN_VERILATOR` overrides the `verilator` binary.
 
 use std::fs;
