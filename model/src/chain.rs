@@ -302,29 +302,21 @@ mod tests {
     use crate::format::DEFAULT_FORMAT;
     use crate::program::Segment;
 
-    #[test]
-    fn wrap_sign_extends_the_low_bits_at_every_width() {
-        let mut r = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            r ^= r << 13;
-            r ^= r >> 7;
-            r ^= r << 17;
-            r
-        };
-        for _ in 0..200 {
-            let value = ((u128::from(next()) << 64) | u128::from(next())) as i128;
-            for bits in 1..=128u32 {
-                let s = 128 - bits;
-                assert_eq!(
-                    wrap(value, bits),
-                    (value << s) >> s,
-                    "{value:#x} at {bits} bits"
-                );
-            }
+    proptest::proptest! {
+        #[test]
+        fn wrap_sign_extends_the_low_bits_at_every_width(value: i128, bits in 1u32..=128) {
+            let s = 128 - bits;
+            proptest::prop_assert_eq!(wrap(value, bits), (value << s) >> s);
         }
+    }
+
+    #[test]
+    fn wrap_at_the_register_edges() {
         assert_eq!(wrap(1 << 103, 104), -(1 << 103));
         assert_eq!(wrap((1 << 103) - 1, 104), (1 << 103) - 1);
         assert_eq!(wrap(-1, 112), -1);
+        assert_eq!(wrap(i128::MIN, 128), i128::MIN);
+        assert_eq!(wrap(1 << 64, 65), -(1 << 64));
     }
 
     #[test]

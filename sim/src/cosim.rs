@@ -330,21 +330,51 @@ impl CosimReport {
     }
 }
 
+/// The model's side of the lockstep.
+struct ModelSide {
+    model: CoreModel,
+    /// Inputs of the previous clock: the fabric's wrapper registers every input, so the core
+    /// sees them one clock late, and so does the model.
+    pending: CoreInputs,
+    /// The chain steps with a program playing on the next clock (`tick && busy` now).
+    ticking: bool,
+}
+
+impl ModelSide {
+    fn new(format: &Format) -> Self {
+        ModelSide {
+            model: CoreModel::new(format),
+            pending: CoreInputs::default(),
+            ticking: false,
+        }
+    }
+
+    /// One clock with inputs `i`: the outputs after it, and whether the chain stepped on it
+    /// with a program playing (a tick of the program).
+    #[inline(always)]
+    fn clock(&mut self, i: &CoreInputs) -> (CoreOutputs, bool) {
+        let ticked = self.ticking;
+        self.model.edge(&self.pending);
+        // The registered tick_div already holds this clock's value, and the combinational
+        // `tick` output compares against it.
+        self.model.set_tick_div(i.tick_div);
+        let m = self.model.outputs();
+        self.ticking = m.tick && m.busy;
+        self.pending = *i;
+        (m, ticked)
+    }
+}
+
 /// The two sides in lockstep.
 struct Lockstep {
     fabric: Option<Fabric>,
-    model: CoreModel,
+    side: ModelSide,
     format: Format,
     clock: u64,
     ticks: u64,
     buf: Vec<u32>,
     fault: Option<Fault>,
     move_index: usize,
-    /// Inputs of the previous clock: the fabric's wrapper registers every input, so the core
-    /// sees them one clock late, and so does the model.
-    pending: CoreInputs,
-    /// The chain steps with a program playing on the next clock (`tick && busy` now).
-    ticking: bool,
     session: usize,
 }
 
@@ -365,15 +395,11 @@ impl Lockstep {
                     for words in self.buf[..k as usize * OUT_WORDS].chunks_exact(OUT_WORDS) {
                         let words: &[u32; OUT_WORDS] =
                             words.try_into().expect("chunks of OUT_WORDS words");
-                        let ticked = self.ticking;
-                        self.model.edge(&self.pending);
-                        // The registered tick_div already holds this clock's value, and the
-                        // combinational `tick` output compares against it.
-                        self.model.set_tick_div(i.tick_div);
-                        let m = self.model.outputs();
-                        self.ticking = m.tick && m.busy;
-                        self.pending = *i;
+                        let (m, ticked) = self.side.clock(i);
                         let faulty = self.fault.is_some_and(|fl| fl.clock == self.clock);
+                        // A word differs (or the fault is due): compare register by register;
+                        // bits outside every register (the harness never sets them) are no
+                        // mismatch.
                         if faulty || differs(&m, words, &masks) {
                             let mut o = decode(words, &f);
                             if let Some(fl) = self.fault.filter(|_| faulty) {
@@ -405,12 +431,8 @@ impl Lockstep {
                 None => {
                     // Model only (the benchmark's reference).
                     for _ in 0..k {
-                        let ticked = self.ticking;
-                        self.model.edge(&self.pending);
-                        self.model.set_tick_div(i.tick_div);
-                        let m = std::hint::black_box(self.model.outputs());
-                        self.ticking = m.tick && m.busy;
-                        self.pending = *i;
+                        let (m, ticked) = self.side.clock(i);
+                        std::hint::black_box(m);
                         self.ticks += u64::from(ticked);
                         self.clock += 1;
                     }
@@ -477,15 +499,13 @@ fn session(
     let format = DEFAULT_FORMAT;
     let mut ls = Lockstep {
         fabric,
-        model: CoreModel::new(&format),
+        side: ModelSide::new(&format),
         format,
         clock: 0,
         ticks: 0,
         buf: Vec::new(),
         fault: cfg.fault,
         move_index: 0,
-        pending: CoreInputs::default(),
-        ticking: false,
         session: cfg.session,
     };
     let start_time = Instant::now();
@@ -509,7 +529,7 @@ fn session(
                 None => stream.next_move(),
             };
             let f = Format::with_ts(spec.ts);
-            let plan = match plan_from(&spec.request, &f, ls.model.chain()) {
+            let plan = match plan_from(&spec.request, &f, ls.side.model.chain()) {
                 Ok(p) if p.ticks_total() <= MAX_MOVE_TICKS => p,
                 _ => {
                     report.skipped += 1;
@@ -571,15 +591,15 @@ fn session(
                     )?;
                     report.soft_stopped += 1;
                 }
-                while ls.model.busy() && budget > 0 {
+                while ls.side.model.busy() && budget > 0 {
                     let k = budget.min(BATCH);
                     ls.drive(&idle, k)?;
                     budget -= k;
                 }
                 // The clock-accurate model must land where the planner said (with the cruise cut
                 // short after a controlled stop).
-                let want = plan.end_after(u64::from(ls.model.outputs().tick_count));
-                if ls.model.chain() != want {
+                let want = plan.end_after(u64::from(ls.side.model.outputs().tick_count));
+                if ls.side.model.chain() != want {
                     report.planner_disagreements += 1;
                 }
             }
@@ -740,38 +760,29 @@ mod tests {
 
     /// Outputs with every field drawn from `seed` (registers wrapped to their widths).
     fn outputs(seed: u64, f: &Format) -> CoreOutputs {
-        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
-        let mut wide = |bits| {
-            let v = (u128::from(next()) << 64 | u128::from(next())) as i128;
-            snapgen_model::chain::wrap(v, bits)
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let mut wide = |bits| snapgen_model::chain::wrap(rng.gen::<i128>(), bits);
         let (x, v, a, j) = (
             wide(f.widths.x),
             wide(f.widths.v),
             wide(f.widths.a),
             wide(f.widths.j),
         );
-        let r = next();
         CoreOutputs {
             x,
             v,
             a,
             j,
-            position: r as u32,
-            segment: (r >> 32) as u8 & 0x3f,
-            busy: r >> 40 & 1 == 1,
-            done: r >> 41 & 1 == 1,
-            aborted: r >> 42 & 1 == 1,
-            tick_count: (r >> 16) as u32,
-            tick: r >> 43 & 1 == 1,
-            active_bank: r >> 44 & 1 == 1,
-            standby_count: (r >> 48) as u8 & 0x3f,
+            position: rng.gen(),
+            segment: rng.gen_range(0..64),
+            busy: rng.gen(),
+            done: rng.gen(),
+            aborted: rng.gen(),
+            tick_count: rng.gen(),
+            tick: rng.gen(),
+            active_bank: rng.gen(),
+            standby_count: rng.gen_range(0..64),
         }
     }
 
