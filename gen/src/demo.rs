@@ -85,7 +85,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     println!("== fabric");
     let files = crate::hw::write_verilog(&out.join("verilog"))?;
     println!(
-        "  Verilog: {} (lint waivers {})",
+        "  Verilog: {} (Verilator waivers and hints {})",
         files.verilog.display(),
         files.waivers.display()
     );
