@@ -82,7 +82,6 @@ pub fn cache_root() -> PathBuf {
     std::env::temp_dir().join("snapgen")
 }
 
-/// FNV-1a, 64 bit: a stable content hash for the cache key.
 /// What `-march=native` compiles for: the first `model name` and `flags` lines of
 /// `/proc/cpuinfo` (empty where there is no such file).
 fn host_cpu() -> String {
@@ -96,6 +95,7 @@ fn host_cpu() -> String {
     format!("{}\n{}", first("model name"), first("flags"))
 }
 
+/// FNV-1a, 64 bit: a stable content hash for the cache key.
 fn fnv1a(parts: &[&[u8]]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for p in parts {
