@@ -405,24 +405,20 @@ impl Lockstep {
                             if let Some(fl) = self.fault.filter(|_| faulty) {
                                 fl.register.flip(&mut o, fl.bit, &f);
                             }
-                            if m == o {
-                                self.ticks += u64::from(ticked);
-                                self.clock += 1;
-                                continue;
-                            }
-                            let register = Register::ALL
+                            if let Some(register) = Register::ALL
                                 .into_iter()
                                 .find(|r| r.bits_of(&m, &f) != r.bits_of(&o, &f))
-                                .expect("outputs differ in some register");
-                            return Err(Mismatch {
-                                session: self.session,
-                                clock: self.clock,
-                                move_index: self.move_index,
-                                register,
-                                expected: register.bits_of(&m, &f),
-                                actual: register.bits_of(&o, &f),
-                                bits: register.bits(&f),
-                            });
+                            {
+                                return Err(Mismatch {
+                                    session: self.session,
+                                    clock: self.clock,
+                                    move_index: self.move_index,
+                                    register,
+                                    expected: register.bits_of(&m, &f),
+                                    actual: register.bits_of(&o, &f),
+                                    bits: register.bits(&f),
+                                });
+                            }
                         }
                         self.ticks += u64::from(ticked);
                         self.clock += 1;
