@@ -1,9 +1,16 @@
-//! Benchmarks of the model: time per plan for each method (target for order 4: ≤ 1 µs median)
-//! and model throughput in ticks per second on long moves (target ≥ 1 G ticks/s, closed-form
-//! segment stepping), plus the per-tick trace that co-simulation uses, for comparison.
+//! Benchmarks of the model, each measuring what its name says:
 //!
-//! Run with `cargo bench -p snapgen-model`. Criterion prints the median time per iteration and,
-//! for the throughput groups, elements (ticks) per second.
+//! * `plan/*`: time per plan for each method (target for order 4: ≤ 1 µs median);
+//! * `model_per_tick/*`: ticks per second when every tick's state is computed and handed to a
+//!   consumer (`ChainState::play`, what a per-tick trace does);
+//! * `model_closed_form/long_move` and `verify/long_move`: the time to evaluate a 1.2e9-tick
+//!   move's end state in closed form (the model), and to check it independently, end state and
+//!   every tick's extremes (snapgen-verify). These cost per segment, not per tick, so they are
+//!   reported as time per move, not as ticks per second.
+//!
+//! Run with `cargo bench -p snapgen-model --bench model`. Criterion prints the median time per
+//! iteration and, for `model_per_tick`, elements (ticks) per second. (`cargo bench -p snapgen-tests --bench vs_ruckig`
+//! compares the planner with Ruckig.)
 
 use std::hint::black_box;
 
@@ -86,25 +93,37 @@ fn bench_throughput(c: &mut Criterion) {
     .unwrap();
     let w = DEFAULT_FORMAT.widths;
     let mut g = c.benchmark_group("model_closed_form");
-    g.throughput(Throughput::Elements(long.ticks_total()));
-    g.bench_function("long_move_ticks", |b| {
+    g.bench_function("long_move", |b| {
         b.iter(|| black_box(long.start).run_program(black_box(&long.program), &w))
     });
     g.finish();
+    let mut g = c.benchmark_group("verify");
+    g.bench_function("long_move", |b| {
+        b.iter(|| {
+            let s = long.start;
+            snapgen_verify::integrate(
+                snapgen_verify::State::new(s.x, s.v, s.a, s.j),
+                black_box(&long.program)
+                    .segments
+                    .iter()
+                    .map(|g| (u64::from(g.ticks), g.snap)),
+            )
+        })
+    });
+    g.finish();
 
-    // The per-tick chain (what co-simulation compares against), on a shorter move.
+    // Every tick of a move computed and seen by a consumer.
     let short = plan(&requests()[0].1, &DEFAULT_FORMAT).unwrap();
     let mut g = c.benchmark_group("model_per_tick");
     g.throughput(Throughput::Elements(short.ticks_total()));
-    g.bench_function("order4_move_ticks", |b| {
+    g.bench_function("order4_move", |b| {
         b.iter(|| {
             let mut s: ChainState = short.start;
+            let mut seen = 0i128;
             for seg in &black_box(&short.program).segments {
-                for _ in 0..seg.ticks {
-                    s = s.step(seg.snap, &w);
-                }
+                s = s.play(seg.snap, u64::from(seg.ticks), &w, |t| seen ^= t.x);
             }
-            s
+            (s, seen)
         })
     });
     g.finish();

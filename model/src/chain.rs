@@ -183,12 +183,55 @@ impl ChainState {
         })
     }
 
+    /// Plays `n` ticks of snap `d`, calling `visit` with the state after each tick: the same
+    /// states as `n` calls of [`ChainState::step`]. When the segment's registers provably stay
+    /// inside their widths (its exact extremes, checked once in closed form), nothing can wrap
+    /// and each tick is four plain additions; otherwise every tick wraps as the hardware does.
+    #[inline]
+    pub fn play(&self, d: i128, n: u64, w: &Widths, mut visit: impl FnMut(&ChainState)) -> Self {
+        let mut s = *self;
+        if n > 16 && wrap(d, w.d) == d && crate::peaks::segment_fits(self, d, n, w) {
+            for _ in 0..n {
+                s = ChainState {
+                    x: s.x + s.v,
+                    v: s.v + s.a,
+                    a: s.a + s.j,
+                    j: s.j + d,
+                };
+                visit(&s);
+            }
+        } else {
+            for _ in 0..n {
+                s = s.step(d, w);
+                visit(&s);
+            }
+        }
+        s
+    }
+
     /// Runs a whole program segment by segment in closed form and returns the final state.
     pub fn run_program(&self, program: &Program, w: &Widths) -> Self {
         program
             .segments
             .iter()
             .fold(*self, |s, seg| s.advance(seg.snap, u64::from(seg.ticks), w))
+    }
+
+    /// The state after the first `ticks` ticks of `program` (closed form per segment; past the
+    /// program's end the chain keeps its last velocity, acceleration and jerk, as it would
+    /// with snap 0).
+    pub fn after_ticks(&self, program: &Program, ticks: u64, w: &Widths) -> Self {
+        let mut left = ticks;
+        let mut s = *self;
+        for seg in &program.segments {
+            let n = left.min(u64::from(seg.ticks));
+            s = s.advance(seg.snap, n, w);
+            left -= n;
+            if left == 0 {
+                return s;
+            }
+        }
+        s.advance(0, left, w)
     }
 }
 
@@ -299,6 +342,25 @@ impl Iterator for Trace<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn after_ticks_is_the_sequencer_tick_by_tick() {
+        let w = crate::DEFAULT_FORMAT.widths;
+        let p = Program {
+            segments: vec![
+                crate::Segment { ticks: 3, snap: 5 },
+                crate::Segment { ticks: 1, snap: -9 },
+                crate::Segment { ticks: 4, snap: 2 },
+            ],
+        };
+        let start = ChainState::at_rest(17);
+        let mut seq = Sequencer::new(&p);
+        let mut s = start;
+        for k in 0..=10u64 {
+            assert_eq!(start.after_ticks(&p, k, &w), s, "tick {k}");
+            s = s.step(seq.tick().unwrap_or(0), &w);
+        }
+    }
     use crate::format::DEFAULT_FORMAT;
     use crate::program::Segment;
 
@@ -307,6 +369,27 @@ mod tests {
         fn wrap_sign_extends_the_low_bits_at_every_width(value: i128, bits in 1u32..=128) {
             let s = 128 - bits;
             proptest::prop_assert_eq!(wrap(value, bits), (value << s) >> s);
+        }
+    }
+
+    proptest::proptest! {
+        /// `play` visits exactly the states of `step`, fast path or not (registers near
+        /// their limits included, so some segments wrap).
+        #[test]
+        fn play_equals_stepping(
+            d in -40i128..40, n in 0u64..200, v in -120i128..120, a in -60i128..60, j in -9i128..9,
+        ) {
+            let w = Widths { x: 20, v: 10, a: 8, j: 8, d: 8 };
+            let start = ChainState { x: 1000, v, a: wrap(a, 8), j };
+            let mut seen = Vec::new();
+            let end = start.play(d, n, &w, |s| seen.push(*s));
+            let mut s = start;
+            for (k, got) in seen.iter().enumerate() {
+                s = s.step(d, &w);
+                proptest::prop_assert_eq!(*got, s, "tick {}", k + 1);
+            }
+            proptest::prop_assert_eq!(end, s);
+            proptest::prop_assert_eq!(seen.len() as u64, n);
         }
     }
 

@@ -1,22 +1,40 @@
 //! Clock-accurate model of the motion core (`snapgen_hdl::core::MotionCore`): tick divider,
-//! two-bank program memory, sequencer and integrator chain, updated once per fabric clock with
-//! exactly the hardware's rules. Co-simulation drives this model and the Verilated core with
-//! the same inputs and compares every output on every clock.
+//! two-bank program memory, sequencer, the controlled-stop unit and the integrator chain,
+//! updated once per fabric clock with exactly the hardware's rules. Co-simulation drives this
+//! model and the Verilated core with the same inputs and compares every output on every clock.
 //!
 //! Per clock, from the values before the edge:
-//! * `tick = divider_count >= tick_div`; the divider restarts on reset or tick.
+//! * `tick = divider ≥ tick_div` unless a stop is computing its next snap (the tick then waits:
+//!   the divider keeps counting and the tick comes on the first clock the snap is ready).
 //! * The sequencer reads the *active* bank while busy and the *standby* bank while idle, at
 //!   address `index + 1` (busy) or 0 (idle).
-//! * A start (accepted only while idle and not stopped or reset) swaps the banks and loads
-//!   segment 0; the bank that was active becomes standby with its count cleared.
+//! * A start (accepted only while idle, not stopping, and without a pending stop, abort or
+//!   reset) swaps the banks and loads segment 0; the bank that was active becomes standby with
+//!   its count cleared.
 //! * On a tick while busy the sequencer counts the tick down and moves to the next segment,
 //!   dropping the snap to 0 and raising `done` after the last one.
-//! * The chain steps with the snap register's value on every tick (see [`crate::chain`]);
-//!   `stop` zeroes v, a, j at once; reset puts x at the centre of cell 0.
+//! * The chain steps on every tick (see [`crate::chain`]) with the sequencer's snap, or while
+//!   stopping with the stop unit's.
+//! * `stop` (a controlled stop, [`crate::stop`]) latches the stop limits and starts the stop
+//!   unit's *Prep* phase (`prep` clocks of [`phase_clocks`], the move plays on); the first tick
+//!   after it takes the stop: the program is cut there (busy and done fall, `aborted` rises if
+//!   it was playing), then the unit spends `init` clocks computing where its law begins and
+//!   `decide` clocks before every tick choosing that tick's snap (ticks wait for it); when the
+//!   registers are at rest it lets go (`stopping` falls). Requests while a stop runs are
+//!   ignored.
+//! * `abort` zeroes v, a and j at once (the emergency stop, with the amplifier off) and
+//!   cancels a stop; reset puts x at the centre of cell 0; `load` puts it at the centre of
+//!   cell `load_position` with v = a = j = 0 (the executor raises it only with the axis at
+//!   rest and no program playing).
+//! * `tick_count` counts the ticks since the last start while a program plays or a stop runs;
+//!   `ticks` counts every tick since reset (64 bits).
+//! * `at_rest` is v = a = j = 0; `heading` (registered) is the sign of the first non-zero of
+//!   v, a, j: where the axis goes next (a move from rest heads somewhere from its first tick).
 //! * Writes go to the standby bank.
 
 use crate::chain::{wrap, ChainState};
 use crate::format::{Format, Widths, FRAC_BITS};
+use crate::stop::{phase_clocks, PhaseClocks, StopLaw, StopLimits};
 
 /// Segments per bank.
 pub const BANK_DEPTH: usize = 32;
@@ -30,8 +48,17 @@ pub struct CoreInputs {
     pub tick_div: u32,
     /// Start the standby program.
     pub start: bool,
-    /// Stop now (abort).
+    /// Abort now: v = a = j = 0 (the emergency stop).
+    pub abort: bool,
+    /// Controlled stop, taken on the next tick.
     pub stop: bool,
+    /// The reference takes the encoder's position: x at the centre of output cell
+    /// `load_position`, v = a = j = 0 (POWER 1 from Disabled, when the axis is at rest).
+    pub load: bool,
+    /// The encoder count for `load` (32 bits).
+    pub load_position: u32,
+    /// The stop's limits (latched when a stop is taken).
+    pub stop_limits: StopLimits,
     /// Write one segment of the standby program.
     pub write_enable: bool,
     /// Segment address to write (0..32).
@@ -44,11 +71,6 @@ pub struct CoreInputs {
     pub count_enable: bool,
     /// Segment count (0..=32).
     pub count_value: u8,
-    /// Cruise segment of the standby program, written with the count (63: none).
-    pub cruise_value: u8,
-    /// Controlled stop: end the cruise now (or as soon as it is reached) and decelerate as
-    /// planned. Ignored while idle.
-    pub soft_stop: bool,
 }
 
 /// The core's outputs after a clock edge.
@@ -66,20 +88,49 @@ pub struct CoreOutputs {
     pub position: u32,
     /// Segment playing.
     pub segment: u8,
-    /// Playing.
+    /// Playing a program.
     pub busy: bool,
-    /// Last program finished.
+    /// Last program ran to its end.
     pub done: bool,
-    /// Last program was stopped.
+    /// Last program was cut short (by a stop or an abort).
     pub aborted: bool,
-    /// Ticks since the start.
+    /// A controlled stop is requested or running.
+    pub stopping: bool,
+    /// The last stop began outside its limits (and landed regardless of them).
+    pub stop_over: bool,
+    /// Ticks since the last start (while playing or stopping).
     pub tick_count: u32,
+    /// Ticks since reset.
+    pub ticks: u64,
     /// Tick enable (combinational, for the next edge).
     pub tick: bool,
+    /// The chain is at rest: v = a = j = 0 (combinational, from the registers).
+    pub at_rest: bool,
+    /// Where the axis is heading (−1, 0, +1), registered from the registers before the last
+    /// edge: the sign of v, or of a when v = 0, or of j when v = a = 0.
+    pub heading: i8,
     /// Bank playing.
     pub active_bank: bool,
     /// Segment count of the standby program.
     pub standby_count: u8,
+}
+
+/// Where the stop unit is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum StopPhase {
+    /// No stop.
+    #[default]
+    Idle,
+    /// Requested; computing what does not depend on the state: clocks left.
+    Prep(u32),
+    /// Ready to take the stop on the next tick.
+    Armed,
+    /// Computing where the law begins: clocks left.
+    Init(u32),
+    /// Choosing the next tick's snap: clocks left.
+    Decide(u32),
+    /// The next tick's snap is ready.
+    Ready(i128),
 }
 
 /// The clock-accurate core model.
@@ -90,8 +141,6 @@ pub struct CoreModel {
     mem_ticks: [[u32; BANK_DEPTH]; 2],
     mem_snap: [[i128; BANK_DEPTH]; 2],
     counts: [u8; 2],
-    cruise: [u8; 2],
-    skip: bool,
     bank: bool,
     aborted: bool,
     divider: u32,
@@ -101,8 +150,15 @@ pub struct CoreModel {
     left: u32,
     snap: i128,
     tick_count: u32,
+    ticks: u64,
     chain: ChainState,
     tick_div: u32,
+    clocks: PhaseClocks,
+    stop_phase: StopPhase,
+    stop_limits: StopLimits,
+    stop_law: Option<StopLaw>,
+    stop_over: bool,
+    heading: i8,
 }
 
 impl CoreModel {
@@ -115,8 +171,6 @@ impl CoreModel {
             mem_ticks: [[0; BANK_DEPTH]; 2],
             mem_snap: [[0; BANK_DEPTH]; 2],
             counts: [0; 2],
-            cruise: [0; 2],
-            skip: false,
             bank: false,
             aborted: false,
             divider: 0,
@@ -126,8 +180,15 @@ impl CoreModel {
             left: 0,
             snap: 0,
             tick_count: 0,
+            ticks: 0,
             chain: ChainState::default(),
             tick_div: 0,
+            clocks: phase_clocks(),
+            stop_phase: StopPhase::Idle,
+            stop_limits: StopLimits::default(),
+            stop_law: None,
+            stop_over: false,
+            heading: 0,
         }
     }
 
@@ -139,6 +200,12 @@ impl CoreModel {
     /// True while a program plays.
     pub fn busy(&self) -> bool {
         self.busy
+    }
+
+    /// True while a controlled stop is requested or runs.
+    #[inline]
+    pub fn stopping(&self) -> bool {
+        self.stop_phase != StopPhase::Idle
     }
 
     /// Segment count of the standby program (0: nothing to start).
@@ -153,12 +220,19 @@ impl CoreModel {
         self.outputs()
     }
 
+    /// The tick enable before the next edge: the divider is due and no stop is computing.
+    #[inline]
+    fn tick_now(&self, tick_div: u32) -> bool {
+        let computing = matches!(self.stop_phase, StopPhase::Init(_) | StopPhase::Decide(_));
+        self.divider >= tick_div && !computing
+    }
+
     /// One rising clock edge with inputs `i` (read the outputs with [`CoreModel::outputs`]).
     #[inline]
     pub fn edge(&mut self, i: &CoreInputs) {
         let w = self.widths;
         // Combinational values before the edge.
-        let tick = self.divider >= i.tick_div;
+        let tick = self.tick_now(i.tick_div);
         let read_bank = usize::from(self.bank ^ !self.busy);
         let count = self.counts[read_bank];
         let address = if self.busy {
@@ -169,12 +243,20 @@ impl CoreModel {
         let entry_ticks = self.mem_ticks[read_bank][address];
         let entry_snap = self.mem_snap[read_bank][address];
         let next_index = (self.index + 1) & 0x3f;
-        let started = !i.reset && !i.stop && i.start && !self.busy;
-        let old_snap = self.snap;
-        let old_bank = self.bank;
-        // A controlled stop ends the cruise segment on its next tick.
-        let cut = self.skip && self.index == self.cruise[read_bank];
+        let stopping = self.stop_phase != StopPhase::Idle;
+        // The stop has been taken: its ticks count.
+        let engaged = matches!(
+            self.stop_phase,
+            StopPhase::Init(_) | StopPhase::Decide(_) | StopPhase::Ready(_)
+        );
         let old_busy = self.busy;
+        let started = !i.reset && !i.abort && i.start && !self.busy && !stopping;
+        let chain_snap = match self.stop_phase {
+            StopPhase::Ready(d) => d,
+            _ => self.snap,
+        };
+        let old_bank = self.bank;
+        let engage = tick && self.stop_phase == StopPhase::Armed && !i.reset && !i.abort;
 
         // Sequencer.
         if i.reset {
@@ -184,7 +266,8 @@ impl CoreModel {
             self.left = 0;
             self.snap = 0;
             self.tick_count = 0;
-        } else if i.stop {
+            self.ticks = 0;
+        } else if i.abort {
             self.busy = false;
             self.snap = 0;
         } else if started {
@@ -199,44 +282,119 @@ impl CoreModel {
                 self.left = entry_ticks;
                 self.snap = entry_snap;
             }
-        } else if tick && self.busy {
-            self.tick_count = self.tick_count.wrapping_add(1);
-            if self.left == 1 || cut {
-                self.index = next_index;
-                if next_index == count {
-                    self.busy = false;
-                    self.done = true;
-                    self.snap = 0;
+        } else if tick {
+            if self.busy || engaged {
+                self.tick_count = self.tick_count.wrapping_add(1);
+            }
+            if engage {
+                // The stop takes the program's place from the next tick.
+                self.busy = false;
+                self.done = false;
+                self.snap = 0;
+            } else if self.busy {
+                if self.left == 1 {
+                    self.index = next_index;
+                    if next_index == count {
+                        self.busy = false;
+                        self.done = true;
+                        self.snap = 0;
+                    } else {
+                        self.left = entry_ticks;
+                        self.snap = entry_snap;
+                    }
                 } else {
-                    self.left = entry_ticks;
-                    self.snap = entry_snap;
+                    self.left = self.left.wrapping_sub(1);
                 }
-            } else {
-                self.left = self.left.wrapping_sub(1);
             }
         }
 
-        // Chain (eqs 72–75 on a tick, from the snap register before the edge).
-        if i.reset {
-            self.chain = ChainState::at_rest(self.home);
-        } else if i.stop {
-            self.chain = ChainState::at_rest(self.chain.x);
-        } else if tick {
-            self.chain = self.chain.step(old_snap, &w);
+        // The time base: every tick since reset.
+        if !i.reset && tick {
+            self.ticks = self.ticks.wrapping_add(1);
         }
 
-        // Tick divider.
+        // The heading register: the sign of the first non-zero of v, a, j.
+        let c = self.chain;
+        self.heading = if c.v != 0 {
+            c.v.signum()
+        } else if c.a != 0 {
+            c.a.signum()
+        } else {
+            c.j.signum()
+        } as i8;
+
+        // Chain (eqs 72–75 on a tick, from the snap before the edge).
+        if i.reset {
+            self.chain = ChainState::at_rest(self.home);
+        } else if i.abort {
+            self.chain = ChainState::at_rest(self.chain.x);
+        } else if i.load {
+            let cell = i128::from(i.load_position as i32) << FRAC_BITS;
+            self.chain = ChainState::at_rest(cell + (1 << (FRAC_BITS - 1)));
+        } else if tick {
+            self.chain = self.chain.step(chain_snap, &w);
+        }
+
+        // The stop unit.
+        if i.reset || i.abort {
+            self.stop_phase = StopPhase::Idle;
+            self.stop_law = None;
+            if i.reset {
+                self.stop_over = false;
+            }
+        } else {
+            let c = self.clocks;
+            self.stop_phase = match self.stop_phase {
+                StopPhase::Idle if i.stop => {
+                    // The fabric's limit inputs are 104-bit unsigned.
+                    let mask = (1i128 << w.d) - 1;
+                    self.stop_limits = StopLimits {
+                        jerk: i.stop_limits.jerk & mask,
+                        accel: i.stop_limits.accel & mask,
+                    };
+                    StopPhase::Prep(c.prep)
+                }
+                StopPhase::Idle => StopPhase::Idle,
+                StopPhase::Prep(n) if n > 1 => StopPhase::Prep(n - 1),
+                StopPhase::Prep(_) => StopPhase::Armed,
+                StopPhase::Armed if engage => StopPhase::Init(c.init),
+                StopPhase::Armed => StopPhase::Armed,
+                StopPhase::Init(n) if n > 1 => StopPhase::Init(n - 1),
+                StopPhase::Init(_) => {
+                    let s = self.chain;
+                    let law = StopLaw::begin(s.v, s.a, s.j, self.stop_limits);
+                    self.stop_over = law.over_limits();
+                    self.stop_law = Some(law);
+                    StopPhase::Decide(c.decide)
+                }
+                StopPhase::Decide(n) if n > 1 => StopPhase::Decide(n - 1),
+                StopPhase::Decide(_) => {
+                    let s = self.chain;
+                    let law = self.stop_law.as_mut().expect("a law while deciding");
+                    match law.next_jerk(s.v, s.a, s.j) {
+                        Some(next) => StopPhase::Ready(wrap(next.wrapping_sub(s.j), w.d)),
+                        None => {
+                            self.stop_law = None;
+                            StopPhase::Idle
+                        }
+                    }
+                }
+                StopPhase::Ready(_) if tick => StopPhase::Decide(c.decide),
+                ready @ StopPhase::Ready(_) => ready,
+            };
+        }
+
+        // Tick divider: counts on while a tick waits for the stop unit.
         self.divider = if i.reset || tick {
             0
         } else {
             self.divider.wrapping_add(1)
         };
 
-        // Banks and counts.
+        // Banks, counts and the cut-short flag.
         if i.reset {
             self.bank = false;
             self.counts = [0; 2];
-            self.cruise = [0; 2];
             self.aborted = false;
         } else if started {
             self.bank = !old_bank;
@@ -244,15 +402,8 @@ impl CoreModel {
             self.counts[usize::from(old_bank)] = 0;
         } else if i.count_enable {
             self.counts[usize::from(!old_bank)] = i.count_value & 0x3f;
-            self.cruise[usize::from(!old_bank)] = i.cruise_value & 0x3f;
         }
-        // Controlled stop: armed while playing, cleared by a start or a reset.
-        if i.reset || started {
-            self.skip = false;
-        } else if i.soft_stop && old_busy && !i.stop {
-            self.skip = true;
-        }
-        if i.stop && !i.reset {
+        if !i.reset && (i.abort || engage) && old_busy {
             self.aborted = true;
         }
 
@@ -274,6 +425,7 @@ impl CoreModel {
     }
 
     /// The outputs as they stand (after the last edge, with the last `tick_div`).
+    #[inline]
     pub fn outputs(&self) -> CoreOutputs {
         CoreOutputs {
             x: self.chain.x,
@@ -285,8 +437,13 @@ impl CoreModel {
             busy: self.busy,
             done: self.done,
             aborted: self.aborted,
+            stopping: self.stopping(),
+            stop_over: self.stop_over,
             tick_count: self.tick_count,
-            tick: self.divider >= self.tick_div,
+            ticks: self.ticks,
+            tick: self.tick_now(self.tick_div),
+            at_rest: self.chain.v == 0 && self.chain.a == 0 && self.chain.j == 0,
+            heading: self.heading,
             active_bank: self.bank,
             standby_count: self.counts[usize::from(!self.bank)],
         }
@@ -316,6 +473,15 @@ mod tests {
         });
     }
 
+    fn reset() -> CoreModel {
+        let mut m = CoreModel::new(&DEFAULT_FORMAT);
+        m.clock(&CoreInputs {
+            reset: true,
+            ..Default::default()
+        });
+        m
+    }
+
     #[test]
     fn core_plays_a_program_like_the_chain() {
         let f = DEFAULT_FORMAT;
@@ -326,11 +492,7 @@ mod tests {
                 Segment { ticks: 4, snap: 2 },
             ],
         };
-        let mut m = CoreModel::new(&f);
-        m.clock(&CoreInputs {
-            reset: true,
-            ..Default::default()
-        });
+        let mut m = reset();
         load(&mut m, &p);
         m.clock(&CoreInputs {
             start: true,
@@ -347,6 +509,8 @@ mod tests {
         let o = m.outputs();
         assert!(o.done && !o.busy);
         assert_eq!(o.tick_count, 8);
+        // Every clock has ticked since the reset (tick_div 0): the loads, the start and the 8.
+        assert_eq!(o.ticks, p.segments.len() as u64 + 1 + 1 + 8);
         assert_eq!(o.segment, 3);
         // A second start without a new upload plays nothing: the standby bank was emptied.
         m.clock(&CoreInputs {
@@ -356,77 +520,101 @@ mod tests {
         assert!(!m.busy() && m.outputs().done);
     }
 
+    /// A controlled stop in the middle of a move: prepared while the move plays on, taken on
+    /// the first tick after that, then `init` clocks to begin the law and `decide` clocks
+    /// before every tick; the chain follows the stop law tick by tick (played here from the
+    /// registers at the tick the stop was taken) and ends at rest.
     #[test]
-    fn a_controlled_stop_cuts_the_cruise_and_lands_at_rest() {
+    fn a_controlled_stop_follows_the_law_to_rest() {
         use crate::planner::{plan, Method, MoveRequest};
         let f = DEFAULT_FORMAT;
+        let c = phase_clocks();
         let p = plan(
             &MoveRequest {
                 distance: 0.5,
-                method: Method::Order4 {
+                method: Method::Order3 {
                     vmax: 1.0,
                     amax: 5.0,
                     jmax: 50.0,
-                    dmax: 1000.0,
                 },
             },
             &f,
         )
         .unwrap();
-        let cruise = p.cruise_segment.expect("this move cruises");
-        assert_eq!(p.program.segments[cruise].ticks, 15_000);
-        let mut m = CoreModel::new(&f);
-        m.clock(&CoreInputs {
-            reset: true,
-            ..Default::default()
-        });
-        for (k, s) in p.program.segments.iter().enumerate() {
-            m.clock(&CoreInputs {
-                write_enable: true,
-                write_address: k as u8,
-                write_ticks: s.ticks,
-                write_snap: s.snap,
-                ..Default::default()
-            });
-        }
-        m.clock(&CoreInputs {
-            count_enable: true,
-            count_value: p.program.segments.len() as u8,
-            cruise_value: cruise as u8,
-            ..Default::default()
-        });
+        let limits = StopLimits {
+            jerk: 2 * p.amplitude_raw.abs(),
+            accel: 1 << 90,
+        };
+        let mut m = reset();
+        load(&mut m, &p.program);
         m.clock(&CoreInputs {
             start: true,
             ..Default::default()
         });
-        // 35 000 ticks of acceleration, then 5 000 of cruise, then the stop.
-        for _ in 0..40_000 {
+        // 12 000 ticks into the jerk phase, then the stop request.
+        for _ in 0..12_000 {
             m.clock(&CoreInputs::default());
         }
-        m.clock(&CoreInputs {
-            soft_stop: true,
+        let o = m.clock(&CoreInputs {
+            stop: true,
+            stop_limits: limits,
             ..Default::default()
         });
-        while m.busy() {
-            m.clock(&CoreInputs::default());
+        assert!(
+            o.stopping && o.busy,
+            "the move plays on while the stop prepares"
+        );
+        // The move plays on for `prep` clocks (a tick each: tick_div is 0), then the next
+        // tick is its last and takes the stop.
+        for _ in 0..c.prep {
+            let o = m.clock(&CoreInputs::default());
+            assert!(o.busy && o.stopping);
         }
-        let played = u64::from(m.outputs().tick_count);
-        let mut short = p.program.clone();
-        short.segments[cruise].ticks -= (p.ticks_total() - played) as u32;
-        let want = ChainState::at_rest(f.home_raw()).run_program(&short, &f.widths);
-        assert!(played < p.ticks_total());
-        assert_eq!(m.chain(), want);
-        assert_eq!(p.end_after(played), want);
+        let at_take = {
+            let before = m.chain();
+            let o = m.clock(&CoreInputs::default());
+            assert!(o.stopping && !o.busy && o.aborted);
+            assert_ne!(m.chain(), before);
+            m.chain()
+        };
+        // No tick for init + decide clocks, then one every decide + 1.
+        let mut clocks = 0u32;
+        while !m.outputs().tick {
+            m.clock(&CoreInputs::default());
+            clocks += 1;
+        }
+        assert_eq!(clocks, c.init + c.decide);
+        let (want, law) = crate::stop::play(at_take, limits, 1 << 30);
+        assert!(!law.over_limits());
+        let mut got = Vec::new();
+        let mut gaps = std::collections::BTreeSet::new();
+        let mut since = 0u32;
+        while m.stopping() {
+            let tick = m.outputs().tick;
+            m.clock(&CoreInputs::default());
+            since += 1;
+            if tick {
+                got.push(m.chain());
+                gaps.insert(since);
+                since = 0;
+            }
+        }
+        assert_eq!(got, want);
         assert!(m.chain().is_at_rest());
+        assert_eq!(gaps.into_iter().skip(1).collect::<Vec<_>>(), [c.decide + 1]);
+        // The 12 000 ticks, the request's, the prep's, the one that took the stop, the stop's.
+        assert_eq!(
+            u64::from(m.outputs().tick_count),
+            12_002 + u64::from(c.prep) + want.len() as u64
+        );
     }
 
     #[test]
     fn tick_divider_spaces_the_ticks() {
-        let f = DEFAULT_FORMAT;
         let p = Program {
             segments: vec![Segment { ticks: 2, snap: 1 }],
         };
-        let mut m = CoreModel::new(&f);
+        let mut m = CoreModel::new(&DEFAULT_FORMAT);
         m.clock(&CoreInputs {
             reset: true,
             tick_div: 2,
@@ -448,5 +636,34 @@ mod tests {
         }
         assert!((4..=6).contains(&clocks), "{clocks}");
         assert_eq!(m.outputs().tick_count, 2);
+    }
+
+    /// The emergency stop: v = a = j = 0 at once, and a stop in progress is cancelled.
+    #[test]
+    fn an_abort_holds_the_position_at_once() {
+        let p = Program {
+            segments: vec![Segment { ticks: 50, snap: 3 }],
+        };
+        let mut m = reset();
+        load(&mut m, &p);
+        m.clock(&CoreInputs {
+            start: true,
+            ..Default::default()
+        });
+        for _ in 0..20 {
+            m.clock(&CoreInputs::default());
+        }
+        m.clock(&CoreInputs {
+            stop: true,
+            stop_limits: StopLimits { jerk: 1, accel: 10 },
+            ..Default::default()
+        });
+        let x = m.chain().x;
+        let o = m.clock(&CoreInputs {
+            abort: true,
+            ..Default::default()
+        });
+        assert!(!o.busy && !o.stopping && o.aborted);
+        assert_eq!(m.chain(), ChainState::at_rest(x));
     }
 }

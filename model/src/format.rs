@@ -192,14 +192,17 @@ impl Format {
         if self.max_segments == 0 {
             return Err(FormatError::MaxSegments);
         }
-        // Every scale must be a finite, positive f64.
+        // Every scale Ts^n / L must be a finite, positive f64 (n = 1..4).
+        let inv_l = 1.0 / self.internal_lsb();
+        let mut ts_n = 1.0;
         for q in [
             Quantity::Velocity,
             Quantity::Acceleration,
             Quantity::Jerk,
             Quantity::Snap,
         ] {
-            let s = self.scale(q);
+            ts_n *= self.ts;
+            let s = ts_n * inv_l;
             if !(s.is_finite() && s > 0.0) {
                 return Err(FormatError::Scale(q.name()));
             }
@@ -208,13 +211,25 @@ impl Format {
     }
 
     /// The internal LSB `L` of the position register, in user units.
+    #[inline]
     pub fn internal_lsb(&self) -> f64 {
-        self.position_lsb * (-(FRAC_BITS as f64)).exp2()
+        // 2^-FRAC_BITS, exact.
+        self.position_lsb * f64::from_bits(((1023 - FRAC_BITS) as u64) << 52)
     }
 
-    /// Raw LSBs per physical unit of `q`: `raw = physical · scale`, `scale = Ts^n / L`.
+    /// Raw LSBs per physical unit of `q`: `raw = physical · scale`, `scale = Ts^n / L`
+    /// (`Ts^n` by plain multiplication, the same on every platform).
+    #[inline]
     pub fn scale(&self, q: Quantity) -> f64 {
-        self.ts.powi(q.ts_power()) / self.internal_lsb()
+        let t = self.ts;
+        let ts_n = match q.ts_power() {
+            0 => 1.0,
+            1 => t,
+            2 => t * t,
+            3 => t * t * t,
+            _ => t * t * t * t,
+        };
+        ts_n / self.internal_lsb()
     }
 
     /// Physical value of a raw register value (nearest f64; exact for |raw| < 2^53).
@@ -299,6 +314,11 @@ impl Format {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn internal_lsb_is_two_to_the_minus_frac_bits() {
+        assert_eq!(Format::with_ts(1e-5).internal_lsb(), 1e-6 * (-80f64).exp2());
+    }
 
     #[test]
     fn default_format_is_valid() {

@@ -4,6 +4,8 @@
 //! * [`program`]: the segment program the fabric plays.
 //! * [`chain`]: the sequencer and the snap integrator chain, per tick and in closed form.
 //! * [`peaks`]: exact register peaks over a program.
+//! * [`timing`]: the clock, UART and tick dividers the fabric is generated for.
+//! * [`stop`]: the fabric's controlled stop from any state (the law, exact).
 //! * [`planner`]: seed 000 (order 4), orders 3 and 2, seed 001 (duration-based), and the
 //!   quantizer that makes the endpoint exact.
 //!
@@ -16,13 +18,16 @@ pub mod error;
 pub mod format;
 pub mod io;
 pub mod peaks;
+pub mod peer;
 pub mod planner;
 pub mod program;
 pub mod protocol;
+pub mod stop;
+pub mod timing;
 
 pub use chain::{ChainState, Sequencer, TickSample, Trace};
 pub use core::{CoreInputs, CoreModel, CoreOutputs};
 pub use error::{FormatError, PlanError, ProgramError};
 pub use format::{Format, PositionFix, Quantity, RegisterRange, Widths, DEFAULT_FORMAT, FRAC_BITS};
-pub use planner::{plan, plan_from, Method, MoveRequest, PhaseTicks, Plan};
+pub use planner::{plan, plan_from, plan_into, Method, MoveRequest, PhaseTicks, Plan};
 pub use program::{Program, Segment, SnapTimeline};

@@ -10,6 +10,7 @@
 use ethnum::I256;
 
 use crate::chain::{binomial, ChainState};
+use crate::format::Widths;
 use crate::program::Program;
 
 /// Largest magnitude reached by each register over a program (raw, exact).
@@ -25,6 +26,19 @@ pub struct Peaks {
     pub j: I256,
     /// max |d| (snap input).
     pub d: I256,
+}
+
+impl Peaks {
+    /// The magnitudes of a state (no snap yet): where peaks start.
+    pub fn at(s: &ExactState) -> Self {
+        Peaks {
+            x: s.x.abs(),
+            v: s.v.abs(),
+            a: s.a.abs(),
+            j: s.j.abs(),
+            d: I256::ZERO,
+        }
+    }
 }
 
 /// The exact chain state, without wrapping.
@@ -140,44 +154,58 @@ fn candidates(increment: &[f64], n: u64, out: &mut Vec<u64>) {
 /// Exact peaks and exact final state of `program` run from `start`.
 pub fn peaks(program: &Program, start: &ChainState) -> (Peaks, ExactState) {
     let mut s = ExactState::from_chain(start);
-    let mut p = Peaks {
-        x: s.x.abs(),
-        v: s.v.abs(),
-        a: s.a.abs(),
-        j: s.j.abs(),
-        d: I256::ZERO,
-    };
+    let mut p = Peaks::at(&s);
     let mut cand = Vec::with_capacity(16);
     for seg in &program.segments {
-        let n = u64::from(seg.ticks);
-        let d = seg.snap;
-        let df = d as f64;
-        let (jf, af, vf) = (s.j.as_f64(), s.a.as_f64(), s.v.as_f64());
-        p.d = p.d.max(I256::from(d).abs());
-        // Jerk is linear: its ends.
-        p.j = p.j.max(s.advance(d, n).j.abs());
-        // Acceleration: increment j_k = j + d k.
-        candidates(&[jf, df], n, &mut cand);
-        for &k in &cand {
-            p.a = p.a.max(s.advance(d, k).a.abs());
-        }
-        // Velocity: increment a_k = a + (j - d/2) k + (d/2) k².
-        candidates(&[af, jf - df / 2.0, df / 2.0], n, &mut cand);
-        for &k in &cand {
-            p.v = p.v.max(s.advance(d, k).v.abs());
-        }
-        // Position: increment v_k = v + (a - j/2 + d/3) k + (j/2 - d/2) k² + (d/6) k³.
-        candidates(
-            &[vf, af - jf / 2.0 + df / 3.0, jf / 2.0 - df / 2.0, df / 6.0],
-            n,
-            &mut cand,
-        );
-        for &k in &cand {
-            p.x = p.x.max(s.advance(d, k).x.abs());
-        }
-        s = s.advance(d, n);
+        s = segment_peaks(&s, seg.snap, u64::from(seg.ticks), &mut p, &mut cand);
     }
     (p, s)
+}
+
+/// Folds into `p` the peaks of `n` ticks of snap `d` from `s`; returns the state after them.
+fn segment_peaks(
+    s: &ExactState,
+    d: i128,
+    n: u64,
+    p: &mut Peaks,
+    cand: &mut Vec<u64>,
+) -> ExactState {
+    let df = d as f64;
+    let (jf, af, vf) = (s.j.as_f64(), s.a.as_f64(), s.v.as_f64());
+    p.d = p.d.max(I256::from(d).abs());
+    // Jerk is linear: its ends.
+    p.j = p.j.max(s.advance(d, n).j.abs());
+    // Acceleration: increment j_k = j + d k.
+    candidates(&[jf, df], n, cand);
+    for &k in cand.iter() {
+        p.a = p.a.max(s.advance(d, k).a.abs());
+    }
+    // Velocity: increment a_k = a + (j - d/2) k + (d/2) k².
+    candidates(&[af, jf - df / 2.0, df / 2.0], n, cand);
+    for &k in cand.iter() {
+        p.v = p.v.max(s.advance(d, k).v.abs());
+    }
+    // Position: increment v_k = v + (a - j/2 + d/3) k + (j/2 - d/2) k² + (d/6) k³.
+    candidates(
+        &[vf, af - jf / 2.0 + df / 3.0, jf / 2.0 - df / 2.0, df / 6.0],
+        n,
+        cand,
+    );
+    for &k in cand.iter() {
+        p.x = p.x.max(s.advance(d, k).x.abs());
+    }
+    s.advance(d, n)
+}
+
+/// True when `n` ticks of snap `d` from `start` keep every register (and the snap) inside its
+/// width: then wrapping never happens and plain additions give the hardware's result.
+pub fn segment_fits(start: &ChainState, d: i128, n: u64, w: &Widths) -> bool {
+    let s = ExactState::from_chain(start);
+    let mut p = Peaks::at(&s);
+    let mut cand = Vec::with_capacity(16);
+    segment_peaks(&s, d, n, &mut p, &mut cand);
+    let max = |bits: u32| I256::from(crate::format::Format::register_max(bits));
+    p.x <= max(w.x) && p.v <= max(w.v) && p.a <= max(w.a) && p.j <= max(w.j) && p.d <= max(w.d)
 }
 
 #[cfg(test)]

@@ -1,11 +1,15 @@
 //! Clock-accurate models of the I/O blocks (`snapgen_hdl`'s `quadrature`, `pwm`, `uart_rx`,
-//! `uart_tx`, `byte_fifo`). Each has a `clock` method that takes one clock's inputs and returns
+//! `uart_tx`, `byte_fifo`, `frame_rx`, `executor`, `reply_queue`, `reply_tx`). Each has a `clock` method that takes one clock's inputs and returns
 //! the outputs after the rising edge, with exactly the hardware's rules, so that the HDL can be
 //! compared with it clock by clock.
 
+pub mod executor;
 pub mod fifo;
+pub mod frame_rx;
 pub mod pwm;
 pub mod quadrature;
+pub mod reply_tx;
+pub mod servo;
 pub mod uart;
 
 /// One input through a two-flop synchroniser and a glitch filter: a new level is accepted

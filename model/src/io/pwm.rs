@@ -3,7 +3,8 @@
 //! A counter runs 0 .. period−1. The signed duty is latched when the counter restarts (so a
 //! change never makes a runt pulse) as a magnitude saturated to the period and a direction;
 //! `pwm` is high while `counter < magnitude`; both outputs are forced low at once when
-//! disabled or on fault.
+//! disabled or on fault: `enable` and `fault` gate them combinationally, so the outputs after
+//! an edge follow the gating inputs as they are after it ([`Pwm::outputs`]).
 
 /// Inputs for one clock.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -33,9 +34,6 @@ pub struct Pwm {
     counter: u16,
     magnitude: u16,
     negative: bool,
-    period: u16,
-    enable: bool,
-    fault: bool,
 }
 
 impl Pwm {
@@ -44,7 +42,7 @@ impl Pwm {
         Self::default()
     }
 
-    /// One clock.
+    /// One clock; the outputs after it with the gating inputs of `i` held.
     #[inline]
     pub fn clock(&mut self, i: &PwmInputs) -> PwmOutputs {
         let wrap = self.counter.wrapping_add(1) >= i.period;
@@ -56,16 +54,12 @@ impl Pwm {
         } else {
             self.counter += 1;
         }
-        self.period = i.period;
-        self.enable = i.enable;
-        self.fault = i.fault;
-        self.outputs()
+        self.outputs(i.enable, i.fault)
     }
 
-    /// The outputs for the current state and the last inputs (`enable` and `fault` gate them
-    /// combinationally).
-    pub fn outputs(&self) -> PwmOutputs {
-        let on = self.enable && !self.fault;
+    /// The outputs for the current state, gated by `enable` and `fault` as they are now.
+    pub fn outputs(&self, enable: bool, fault: bool) -> PwmOutputs {
+        let on = enable && !fault;
         PwmOutputs {
             pwm: on && self.counter < self.magnitude,
             dir: on && self.negative,

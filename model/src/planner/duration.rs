@@ -17,7 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{ContinuousProfile, PhaseTicks};
+use super::{fmath, ContinuousProfile, PhaseTicks};
 use crate::error::PlanError;
 
 /// The seed 001 values of a duration-based move (physical units, signed by direction).
@@ -64,9 +64,9 @@ pub fn values(i: &DurationInput) -> DurationValues {
 /// Rounds the phases to ticks and recomputes the jerk (tick units) for `|θd|`.
 pub fn plan(i: &DurationInput, ts: f64) -> Result<ContinuousProfile, PlanError> {
     let v = values(i);
-    let total = (i.duration / ts).round() as u64;
-    let t_acc = ((v.t_acc / ts).round() as u64).min(total / 2);
-    let tj = ((v.t_jerk / ts).round() as u64).min(t_acc / 2);
+    let total = fmath::round(i.duration / ts) as u64;
+    let t_acc = (fmath::round(v.t_acc / ts) as u64).min(total / 2);
+    let tj = (fmath::round(v.t_jerk / ts) as u64).min(t_acc / 2);
     if tj == 0 {
         return Err(PlanError::DurationTooShort {
             duration: i.duration,

@@ -9,6 +9,7 @@
 //!    output position lands exactly on the target and every limit holds on the integer trace.
 
 pub mod duration;
+pub mod fmath;
 pub mod order2;
 pub mod order3;
 pub mod order4;
@@ -18,12 +19,12 @@ use ethnum::I256;
 use serde::{Deserialize, Serialize};
 
 use crate::chain::ChainState;
-use crate::error::PlanError;
+use crate::error::{PlanError, ProgramError};
 use crate::format::{Format, Quantity, FRAC_BITS};
 use crate::peaks::{peaks, Peaks};
 use crate::program::Program;
 pub use duration::{DurationInput, DurationValues};
-use quantize::{div_ceil, unit_response, unit_ticks, Shape};
+use quantize::{unit_response, unit_ticks, Shape};
 
 /// Phase times in ticks. Order 4: `d` = t_d, `j` = t_j, `a` = t_a, `v` = t_v (seed 000);
 /// order 3: `j`, `a`, `v` (jerk, constant acceleration, cruise; `d` = 0); order 2: `a`, `v`.
@@ -53,18 +54,26 @@ pub struct ContinuousProfile {
 /// floating-point noise, so a phase computed as 3.0000000002 ticks is 3 ticks, not 4; negative
 /// or NaN times are 0.
 pub fn ceil_ticks(t: f64) -> u64 {
+    ceil_ticks_f(t) as u64
+}
+
+/// [`ceil_ticks`] as an f64 (a whole number): the continuous planners compute with it, and
+/// skip two slow conversions per phase.
+#[inline]
+pub fn ceil_ticks_f(t: f64) -> f64 {
     if t.is_nan() || t <= 1e-6 {
-        0
+        0.0
     } else if t >= 1e18 {
-        u64::MAX / 4
+        (u64::MAX / 4) as f64
     } else {
-        (t - 1e-6).ceil() as u64
+        fmath::ceil(t - 1e-6)
     }
 }
 
-/// [`ceil_ticks`], at least one tick.
-pub fn ceil_ticks_min1(t: f64) -> u64 {
-    ceil_ticks(t).max(1)
+/// [`ceil_ticks_f`], at least one tick.
+#[inline]
+pub fn ceil_ticks_min1_f(t: f64) -> f64 {
+    ceil_ticks_f(t).max(1.0)
 }
 
 /// How a move is planned.
@@ -212,12 +221,37 @@ pub struct Plan {
     pub program: Program,
     /// Seed 001 values (duration method only).
     pub duration_values: Option<DurationValues>,
-    /// Index of the cruise segment (constant velocity, jerk and acceleration zero), if the
-    /// move has one: a controlled stop ends it early and decelerates as planned.
-    pub cruise_segment: Option<usize>,
 }
 
 impl Plan {
+    /// A plan of nothing (an empty program) from `start`.
+    fn empty(format: Format, request: MoveRequest, start: ChainState) -> Self {
+        Plan {
+            format,
+            request,
+            phases: PhaseTicks::default(),
+            cruise_extension: 0,
+            continuous_amplitude: 0.0,
+            amplitude_raw: 0,
+            target_lsb: 0,
+            start,
+            final_state: start,
+            peaks: Peaks::default(),
+            program: Program::empty(),
+            duration_values: None,
+        }
+    }
+
+    /// Back to [`Plan::empty`], keeping the program's memory.
+    fn reset(&mut self, format: Format, request: MoveRequest, start: ChainState) {
+        let mut program = std::mem::take(&mut self.program);
+        program.segments.clear();
+        *self = Plan {
+            program,
+            ..Plan::empty(format, request, start)
+        };
+    }
+
     /// Profile order.
     pub fn order(&self) -> u8 {
         self.request.method.order()
@@ -226,22 +260,6 @@ impl Plan {
     /// Ticks the program lasts.
     pub fn ticks_total(&self) -> u64 {
         self.program.total_ticks()
-    }
-
-    /// Where the move stands when the sequencer finishes after `played` ticks: the planned end,
-    /// or — after a controlled stop, which cuts the cruise short (the fabric always plays at
-    /// least one cruise tick) — the same program with that many fewer cruise ticks.
-    pub fn end_after(&self, played: u64) -> ChainState {
-        let total = self.ticks_total();
-        match self.cruise_segment {
-            Some(c) if played < total => {
-                let mut p = self.program.clone();
-                let cut = (total - played).min(u64::from(p.segments[c].ticks) - 1);
-                p.segments[c].ticks -= cut as u32;
-                self.start.run_program(&p, &self.format.widths)
-            }
-            _ => self.final_state,
-        }
     }
 
     /// Duration in seconds.
@@ -375,37 +393,38 @@ pub fn plan_from(
     format: &Format,
     start: ChainState,
 ) -> Result<Plan, PlanError> {
+    let mut plan = Plan::empty(*format, *request, start);
+    plan_into(request, format, start, &mut plan)?;
+    Ok(plan)
+}
+
+/// [`plan_from`] into an existing plan, reusing its program's memory: what a host that plans
+/// move after move (or a benchmark) calls, as Ruckig's `calculate` fills a trajectory it is
+/// given. On an error `plan` holds no valid move.
+pub fn plan_into(
+    request: &MoveRequest,
+    format: &Format,
+    start: ChainState,
+    plan: &mut Plan,
+) -> Result<(), PlanError> {
     validate(request, format)?;
     let f = *format;
     let m = request.method;
     // Position range: output cells representable by the position register, with one cell of
     // headroom on each side.
-    let cells = (1i128 << (f.widths.x - FRAC_BITS - 1)) - 1;
-    let max_distance = f.max_distance();
-    let target_f = (request.distance / f.position_lsb).round();
+    let cells = (1i64 << (f.widths.x - FRAC_BITS - 1)) - 1;
+    let target_f = fmath::round(request.distance / f.position_lsb);
     let start_cell = f.output_lsb(start.x);
-    if target_f.abs() > (cells - 1) as f64 || (start_cell + target_f as i128).abs() > cells - 1 {
+    if target_f.abs() > (cells - 1) as f64
+        || (start_cell + target_f as i64 as i128).abs() > i128::from(cells - 1)
+    {
         return Err(PlanError::DistanceOutOfRange {
             distance: request.distance,
-            max: max_distance,
+            max: f.max_distance(),
         });
     }
-    let target_lsb = target_f as i128;
-    let mut plan = Plan {
-        format: f,
-        request: *request,
-        phases: PhaseTicks::default(),
-        cruise_extension: 0,
-        continuous_amplitude: 0.0,
-        amplitude_raw: 0,
-        target_lsb,
-        start,
-        final_state: start,
-        peaks: Peaks::default(),
-        program: Program::empty(),
-        duration_values: None,
-        cruise_segment: None,
-    };
+    plan.reset(f, *request, start);
+    plan.target_lsb = target_f as i64 as i128;
     if let Method::Duration {
         duration,
         gamma,
@@ -419,17 +438,17 @@ pub fn plan_from(
             phi,
         }));
     }
-    // Distance from the start register to the centre of the target cell.
-    let x_total = I256::from(plan.target_raw()) - I256::from(start.x);
+    // Distance from the start register to the centre of the target cell (< 2^112).
+    let x_total = plan.target_raw() - start.x;
     if x_total == 0 {
         let (pk, _) = peaks(&plan.program, &start);
         plan.peaks = pk;
-        return Ok(plan);
+        return Ok(());
     }
     let sign: i128 = if x_total < 0 { -1 } else { 1 };
-    let x_abs = x_total.abs();
+    let x_abs = x_total.unsigned_abs();
     // The continuous planner works on the distance the integer plan actually covers.
-    let dist = x_abs.as_f64() * f.internal_lsb();
+    let dist = to_f64(x_abs) * f.internal_lsb();
     let ts = f.ts;
     let cont = match m {
         Method::Order4 {
@@ -440,20 +459,20 @@ pub fn plan_from(
         } => order4::plan(&order4::TickLimits4 {
             x: dist,
             v: vmax * ts,
-            a: amax * ts.powi(2),
-            j: jmax * ts.powi(3),
-            d: dmax * ts.powi(4),
+            a: amax * (ts * ts),
+            j: jmax * (ts * ts * ts),
+            d: dmax * (ts * ts * ts * ts),
         }),
         Method::Order3 { vmax, amax, jmax } => order3::plan(&order3::TickLimits3 {
             x: dist,
             v: vmax * ts,
-            a: amax * ts.powi(2),
-            j: jmax * ts.powi(3),
+            a: amax * (ts * ts),
+            j: jmax * (ts * ts * ts),
         }),
         Method::Order2 { vmax, amax } => order2::plan(&order2::TickLimits2 {
             x: dist,
             v: vmax * ts,
-            a: amax * ts.powi(2),
+            a: amax * (ts * ts),
         }),
         Method::Duration {
             duration,
@@ -474,25 +493,25 @@ pub fn plan_from(
         3 => Quantity::Jerk,
         _ => Quantity::Acceleration,
     };
-    plan.continuous_amplitude = sign as f64 * cont.amplitude / ts.powi(amp_q_power(amp_q));
-    quantize_into(&mut plan, cont.phases, sign, x_abs)?;
-    Ok(plan)
+    plan.continuous_amplitude = sign as f64 * cont.amplitude / ts_power(ts, amp_q);
+    quantize_into(plan, cont.phases, sign, x_abs)
 }
 
-fn amp_q_power(q: Quantity) -> i32 {
+/// `Ts^n` for the power of `Ts` in `q`'s tick units, by plain multiplication.
+fn ts_power(ts: f64, q: Quantity) -> f64 {
     match q {
-        Quantity::Snap => 4,
-        Quantity::Jerk => 3,
-        Quantity::Acceleration => 2,
-        Quantity::Velocity => 1,
-        Quantity::Position => 0,
+        Quantity::Snap => ts * ts * ts * ts,
+        Quantity::Jerk => ts * ts * ts,
+        Quantity::Acceleration => ts * ts,
+        Quantity::Velocity => ts,
+        Quantity::Position => 1.0,
     }
 }
 
-/// Raw limits `(quantity, flag, floor(limit · scale))`, `None` where the register is the bound.
-fn raw_limits(m: &Method, f: &Format) -> Result<Vec<(Quantity, Option<I256>)>, PlanError> {
-    let mut out = Vec::new();
-    for (q, _, value) in m.limits().iter() {
+/// Raw limits `(quantity, floor(limit · scale))`, `None` where the register is the bound.
+fn raw_limits(m: &Method, f: &Format) -> Result<[(Quantity, Option<u128>); 4], PlanError> {
+    let mut out = [(Quantity::Position, None); 4];
+    for (k, (q, _, value)) in m.limits().iter().enumerate() {
         let raw = value * f.scale(q);
         if raw < 1.0 {
             return Err(PlanError::LimitBelowResolution {
@@ -502,25 +521,37 @@ fn raw_limits(m: &Method, f: &Format) -> Result<Vec<(Quantity, Option<I256>)>, P
                 unit: q.unit(),
             });
         }
-        out.push((
+        out[k] = (
             q,
             if raw >= 2f64.powi(126) {
                 None
             } else {
-                Some(I256::from(raw.floor() as i128))
+                Some(to_u128(fmath::floor(raw)))
             },
-        ));
+        );
     }
     Ok(out)
 }
 
-fn unit_peak(p: &Peaks, q: Quantity) -> I256 {
-    match q {
-        Quantity::Position => p.x,
-        Quantity::Velocity => p.v,
-        Quantity::Acceleration => p.a,
-        Quantity::Jerk => p.j,
-        Quantity::Snap => p.d,
+/// A non-negative f64 below 2^127 as u128, truncated (a hardware conversion below 2^64; the
+/// software one above).
+#[inline]
+fn to_u128(x: f64) -> u128 {
+    if x < 18_446_744_073_709_551_616.0 {
+        x as u64 as u128
+    } else {
+        x as u128
+    }
+}
+
+/// `u` as an f64, by two hardware conversions (the software `u128 → f64` is slower); within
+/// an ulp or two, which is all the callers need (a first comparison, then exact integers).
+#[inline]
+fn to_f64(u: u128) -> f64 {
+    if u >> 64 == 0 {
+        u as u64 as f64
+    } else {
+        ((u >> 64) as u64 as f64) * 18_446_744_073_709_551_616.0 + (u as u64 as f64)
     }
 }
 
@@ -529,7 +560,7 @@ fn quantize_into(
     plan: &mut Plan,
     mut phases: PhaseTicks,
     sign: i128,
-    x_abs: I256,
+    x_abs: u128,
 ) -> Result<(), PlanError> {
     let f = plan.format;
     let m = plan.request.method;
@@ -541,6 +572,21 @@ fn quantize_into(
         seconds: ticks as f64 * f.ts,
         max_ticks,
     };
+    // The bound on each quantity's peak: its requested limit or its register's width,
+    // whichever is smaller (and which of the two it is, for the error message).
+    let mut bounds = [(0u128, Quantity::Snap, false); 4];
+    for (b, q) in bounds.iter_mut().zip([
+        Quantity::Velocity,
+        Quantity::Acceleration,
+        Quantity::Jerk,
+        Quantity::Snap,
+    ]) {
+        let register = Format::register_max(f.width(q)) as u128;
+        *b = match limits.iter().find(|(lq, raw)| *lq == q && raw.is_some()) {
+            Some(&(_, Some(raw))) if raw <= register => (raw, q, true),
+            _ => (register, q, false),
+        };
+    }
     let mut extension = 0u64;
     // At most a few rounds: the closed-form extension lands at K ≤ K_lim in one step, a second
     // round only re-checks.
@@ -556,40 +602,17 @@ fn quantize_into(
             });
         };
         let gain = unit.gain;
-        // Largest amplitude allowed by every limit and by every register's width:
-        // min(floor(bound / unit_peak)).
-        let mut bounds: [(I256, Quantity, bool); 8] = [(I256::ZERO, Quantity::Snap, false); 8];
-        let mut n = 0;
-        for (q, raw) in &limits {
-            if let Some(raw) = raw {
-                bounds[n] = (*raw, *q, true);
-                n += 1;
+        // Largest amplitude allowed by every bound: K_lim = min(floor(bound / unit_peak)),
+        // exact.
+        let mut best: Option<(u128, Quantity, bool)> = None;
+        for &(bound, q, is_limit) in &bounds {
+            if let Some(k) = bound.checked_div(unit.peaks.get(q)) {
+                if best.is_none_or(|(kb, _, _)| k < kb) {
+                    best = Some((k, q, is_limit));
+                }
             }
         }
-        for q in [
-            Quantity::Velocity,
-            Quantity::Acceleration,
-            Quantity::Jerk,
-            Quantity::Snap,
-        ] {
-            bounds[n] = (I256::from(Format::register_max(f.width(q))), q, false);
-            n += 1;
-        }
-        // The tightest bound: compare bound/peak fractions by cross-multiplying (exact in
-        // 256 bits), then divide once.
-        let mut best: Option<(I256, I256, Quantity, bool)> = None;
-        for &(bound, q, is_limit) in &bounds[..n] {
-            let peak = unit_peak(&unit.peaks, q);
-            if peak <= 0 {
-                continue;
-            }
-            if best.is_none_or(|(b, p, _, _)| bound * p < b * peak) {
-                best = Some((bound, peak, q, is_limit));
-            }
-        }
-        // Both fit i128 (bounds ≤ 2^126, peaks come from i128).
-        let k_lim = best.map(|(b, p, q, l)| (I256::from(b.as_i128() / p.as_i128()), q, l));
-        let (k_lim, bound_q, is_limit) = k_lim.expect("the unit program has a snap peak");
+        let (k_lim, bound_q, is_limit) = best.expect("the unit program has a snap peak");
         if k_lim < 1 {
             return Err(if is_limit {
                 let (_, _, value) = m
@@ -600,60 +623,61 @@ fn quantize_into(
                 PlanError::LimitBelowResolution {
                     quantity: bound_q.name(),
                     limit: value,
-                    lsb: unit_peak(&unit.peaks, bound_q).as_f64() / f.scale(bound_q),
+                    lsb: unit.peaks.get(bound_q) as f64 / f.scale(bound_q),
                     unit: bound_q.unit(),
                 }
             } else {
                 PlanError::Overflow {
                     quantity: bound_q.name(),
-                    needed: unit_peak(&unit.peaks, bound_q).as_f64().log2() + 1.0,
+                    needed: (unit.peaks.get(bound_q) as f64).log2() + 1.0,
                     bits: f.width(bound_q),
                 }
             });
         }
-        if gain >= I256::ONE << FRAC_BITS {
+        if gain >= 1u128 << FRAC_BITS {
             return Err(PlanError::GainTooLarge {
-                log2_gain: gain.as_f64().log2(),
+                log2_gain: (gain as f64).log2(),
                 frac: FRAC_BITS,
             });
         }
-        // X < 2^112 and P < 2^80: round(X / P) in i128.
-        let (x128, p128) = (x_abs.as_i128(), gain.as_i128());
-        let k = I256::from((2 * x128 + p128) / (2 * p128));
+        // X < 2^112 and P < 2^80: K = round(X / P) = floor((2X + P) / 2P).
+        let k = (2 * x_abs + gain) / (2 * gain);
         if k > k_lim {
             // Lengthen the cruise so that K_lim · P' ≥ X: each tick adds the cruise velocity.
             let cruise_v = unit.peaks.v;
-            let more = div_ceil(x_abs - k_lim * gain, k_lim * cruise_v);
-            let more =
-                u64::try_from(more.as_u128().min(u128::from(u64::MAX / 4))).expect("clamped");
+            let more = (x_abs - k_lim * gain).div_ceil(k_lim * cruise_v);
+            let more = u64::try_from(more.min(u128::from(u64::MAX / 4))).expect("clamped");
             phases.v += more.max(1);
             extension += more.max(1);
             continue;
         }
-        let k = i128::try_from(k).expect("k ≤ k_lim ≤ register max");
+        let k = k as i128;
         let amp = sign * k;
-        let program = unit.pieces.to_program(amp);
-        plan.cruise_segment =
-            quantize::Pieces::cruise_segment(&program, quantize::cruise_ticks(shape, &phases));
-        program.validate(&f)?;
+        unit.pieces.write_program(amp, &mut plan.program);
+        let program = &plan.program;
+        // Every segment fits the format: the tick total and each bound were checked above;
+        // only the memory depth is left (a unit program has at most 17 segments).
+        if program.segments.len() > f.max_segments {
+            return Err(ProgramError::TooManySegments {
+                count: program.segments.len(),
+                max: f.max_segments,
+            }
+            .into());
+        }
+        debug_assert_eq!(program.validate(&f), Ok(()));
         // The chain is linear and starts at rest, so the move's peaks are |K| times the unit
-        // peaks, exactly; the position is monotonic, so its extremes are the two ends.
-        let kk = I256::from(k);
-        let start_x = I256::from(plan.start.x);
-        let end = crate::peaks::ExactState {
-            x: start_x + I256::from(sign) * kk * gain,
-            ..Default::default()
+        // peaks, exactly (each within its bound, so in i128); the position is monotonic, so its
+        // extremes are the two ends.
+        let scaled = |p: u128| I256::from(k * p as i128);
+        let end_x = plan.start.x + sign * k * gain as i128;
+        plan.peaks = Peaks {
+            x: I256::from(plan.start.x.abs().max(end_x.abs())),
+            v: scaled(unit.peaks.v),
+            a: scaled(unit.peaks.a),
+            j: scaled(unit.peaks.j),
+            d: scaled(unit.peaks.d),
         };
-        let pk = Peaks {
-            x: start_x.abs().max(end.x.abs()),
-            v: kk * unit.peaks.v,
-            a: kk * unit.peaks.a,
-            j: kk * unit.peaks.j,
-            d: kk * unit.peaks.d,
-        };
-        plan.final_state = end.to_chain().expect("peaks fit their registers");
-        plan.peaks = pk;
-        plan.program = program;
+        plan.final_state = ChainState::at_rest(end_x);
         plan.amplitude_raw = amp;
         plan.phases = phases;
         plan.cruise_extension = extension;

@@ -4,7 +4,7 @@
 //! Tick units as in [`super::order4`]. With `s` the acceleration magnitude, `ta` the
 //! acceleration phase and `tv` the cruise (ticks): `v_peak = s·ta`, `x = v_peak·(ta+tv)`.
 
-use super::{ceil_ticks, ceil_ticks_min1, ContinuousProfile, PhaseTicks};
+use super::{ceil_ticks_f, ceil_ticks_min1_f, ContinuousProfile, PhaseTicks};
 
 /// Limits and distance in tick units.
 #[derive(Clone, Copy, Debug)]
@@ -20,14 +20,14 @@ pub struct TickLimits2 {
 /// Plans `ta`, `tv` (ticks) and the acceleration magnitude (tick units).
 pub fn plan(l: &TickLimits2) -> ContinuousProfile {
     // ta from the distance alone: x = s·ta².
-    let mut ta = ceil_ticks_min1((l.x / l.a).sqrt()) as f64;
+    let mut ta = ceil_ticks_min1_f((l.x / l.a).sqrt());
     let mut s = l.x / (ta * ta);
     // Velocity check: v_peak = s·ta.
     if s * ta > l.v {
-        ta = ceil_ticks_min1(l.v / l.a) as f64;
+        ta = ceil_ticks_min1_f(l.v / l.a);
         s = l.v / ta;
     }
-    let tv = ceil_ticks((l.x - s * ta * ta) / l.v) as f64;
+    let tv = ceil_ticks_f((l.x - s * ta * ta) / l.v);
     s = l.x / (ta * (ta + tv));
     ContinuousProfile {
         phases: PhaseTicks {

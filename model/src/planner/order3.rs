@@ -11,7 +11,7 @@
 //! `tj` from the distance, then the velocity and acceleration checks; `ta` from the quadratic,
 //! then the velocity check; `tv` last; the jerk is recomputed after every rounding.
 
-use super::{ceil_ticks, ceil_ticks_min1, ContinuousProfile, PhaseTicks};
+use super::{ceil_ticks_f, ceil_ticks_min1_f, fmath, ContinuousProfile, PhaseTicks};
 
 /// Limits and distance in tick units.
 #[derive(Clone, Copy, Debug)]
@@ -29,31 +29,32 @@ pub struct TickLimits3 {
 /// Plans `tj`, `ta`, `tv` (ticks) and the jerk magnitude (tick units).
 pub fn plan(l: &TickLimits3) -> ContinuousProfile {
     // tj from the distance alone: x = 2·s·tj³.
-    let mut tj = ceil_ticks_min1((l.x / (2.0 * l.j)).cbrt()) as f64;
-    let mut s = l.x / (2.0 * tj.powi(3));
+    let mut tj = ceil_ticks_min1_f(fmath::cbrt(l.x / (2.0 * l.j)));
+    let mut s = l.x / (2.0 * tj * tj * tj);
     // Velocity check: v_peak = s·tj².
     if s * tj * tj > l.v {
-        tj = ceil_ticks_min1((l.v / l.j).sqrt()) as f64;
+        tj = ceil_ticks_min1_f((l.v / l.j).sqrt());
         s = l.v / (tj * tj);
     }
     // Acceleration check: a_peak = s·tj.
     if s * tj > l.a {
-        tj = ceil_ticks_min1(l.a / l.j) as f64;
+        tj = ceil_ticks_min1_f(l.a / l.j);
         s = l.a / tj;
     }
-    let s1 = s;
+    // 1/(s·tj) with the jerk of the t_j step, used by both t_a candidates below.
+    let inv_s1_tj = 1.0 / (s * tj);
     // ta from x = s·tj·(tj+ta)·(2tj+ta): ta² + 3tj·ta + 2tj² − x/(s·tj) = 0.
-    let ta_x = (-3.0 * tj + (tj * tj + 4.0 * l.x / (s1 * tj)).max(0.0).sqrt()) / 2.0;
-    let mut ta = ceil_ticks(ta_x) as f64;
+    let ta_x = (-3.0 * tj + (tj * tj + 4.0 * l.x * inv_s1_tj).max(0.0).sqrt()) / 2.0;
+    let mut ta = ceil_ticks_f(ta_x);
     s = l.x / (tj * (tj + ta) * (2.0 * tj + ta));
     // Velocity check: v_peak = s·tj·(tj+ta).
     if s * tj * (tj + ta) > l.v {
-        ta = ceil_ticks(l.v / (s1 * tj) - tj) as f64;
+        ta = ceil_ticks_f(l.v * inv_s1_tj - tj);
         s = l.v / (tj * (tj + ta));
     }
     // Cruise for the distance left at the velocity limit.
     let moved = s * tj * (tj + ta) * (2.0 * tj + ta);
-    let tv = ceil_ticks((l.x - moved) / l.v) as f64;
+    let tv = ceil_ticks_f((l.x - moved) / l.v);
     s = l.x / (tj * (tj + ta) * (2.0 * tj + ta + tv));
     ContinuousProfile {
         phases: PhaseTicks {

@@ -16,7 +16,7 @@
 //! checks), 3.2 `t_j` (Cardano cubic, then velocity, acceleration), 3.3 `t_a` (quadratic, then
 //! velocity), 3.4 `t_v`.
 
-use super::{ceil_ticks, ceil_ticks_min1, ContinuousProfile, PhaseTicks};
+use super::{ceil_ticks_f, ceil_ticks_min1_f, fmath, ContinuousProfile, PhaseTicks};
 
 /// Limits and distance in tick units (see the module documentation).
 #[derive(Clone, Copy, Debug)]
@@ -36,21 +36,21 @@ pub struct TickLimits4 {
 /// Section 3.1: `t_d` and the snap after its last rounding (eqs 4–22).
 fn phase_d(l: &TickLimits4) -> (f64, f64) {
     // eqs 4–6: td from distance alone, x = 8·s·td⁴.
-    let mut td = ceil_ticks_min1((l.x / (8.0 * l.d)).sqrt().sqrt()) as f64;
-    let mut s = l.x / (8.0 * td.powi(4));
+    let mut td = ceil_ticks_min1_f((l.x / (8.0 * l.d)).sqrt().sqrt());
+    let mut s = l.x / (8.0 * td * td * td * td);
     // eqs 7–11: velocity check, v_peak = 2·s·td³.
-    if 2.0 * s * td.powi(3) > l.v {
-        td = ceil_ticks_min1((l.v / (2.0 * l.d)).cbrt()) as f64;
-        s = l.v / (2.0 * td.powi(3));
+    if 2.0 * s * td * td * td > l.v {
+        td = ceil_ticks_min1_f(fmath::cbrt(l.v / (2.0 * l.d)));
+        s = l.v / (2.0 * td * td * td);
     }
     // eqs 12–16: acceleration check, a_peak = s·td².
     if s * td * td > l.a {
-        td = ceil_ticks_min1((l.a / l.d).sqrt()) as f64;
+        td = ceil_ticks_min1_f((l.a / l.d).sqrt());
         s = l.a / (td * td);
     }
     // eqs 17–21: jerk check, j_peak = s·td.
     if s * td > l.j {
-        td = ceil_ticks_min1(l.j / l.d) as f64;
+        td = ceil_ticks_min1_f(l.j / l.d);
         s = l.j / td;
     }
     (td, s)
@@ -61,21 +61,21 @@ fn phase_j(l: &TickLimits4, td: f64, s3: f64) -> (f64, f64) {
     // eq 23: x = 2·s·td·(td+tj)·(2td+tj)², a cubic in tj. With tj = u − 5td/3 it is depressed
     // to u³ + 3P·u + 2Q = 0, P = −td²/9, Q = −td³/27 − x/(4·s·td), solved by Cardano.
     let p = -td * td / 9.0;
-    let q = -td.powi(3) / 27.0 - l.x / (4.0 * s3 * td);
-    let disc = (p.powi(3) + q * q).sqrt();
-    let r = (-q + disc).cbrt();
+    let q = -td * td * td / 27.0 - l.x / (4.0 * s3 * td);
+    let disc = (p * p * p + q * q).sqrt();
+    let r = fmath::cbrt(-q + disc);
     let tj_x = r - p / r - 5.0 / 3.0 * td;
-    let mut tj = ceil_ticks(tj_x) as f64;
+    let mut tj = ceil_ticks_f(tj_x);
     // eq 25: snap from the rounded times.
-    let mut s = l.x / (2.0 * td * (td + tj) * (2.0 * td + tj).powi(2));
+    let mut s = l.x / (2.0 * td * (td + tj) * (2.0 * td + tj) * (2.0 * td + tj));
     // eqs 26–30: velocity check, v_peak = s·td·(td+tj)·(2td+tj).
     if s * td * (td + tj) * (2.0 * td + tj) > l.v {
-        tj = ceil_ticks((td * td / 4.0 + l.v / (s3 * td)).sqrt() - 1.5 * td) as f64;
+        tj = ceil_ticks_f((td * td / 4.0 + l.v / (s3 * td)).sqrt() - 1.5 * td);
         s = l.v / (td * (td + tj) * (2.0 * td + tj));
     }
     // eqs 31–35: acceleration check, a_peak = s·td·(td+tj).
     if s * td * (td + tj) > l.a {
-        tj = ceil_ticks(l.a / (s3 * td) - td) as f64;
+        tj = ceil_ticks_f(l.a / (s3 * td) - td);
         s = l.a / (td * (td + tj));
     }
     (tj, s)
@@ -85,7 +85,7 @@ fn phase_j(l: &TickLimits4, td: f64, s3: f64) -> (f64, f64) {
 fn coefficients(td: f64, tj: f64) -> (f64, f64, f64) {
     let c1 = td * (td + tj);
     let c2 = 3.0 * td * (td + tj) * (2.0 * td + tj);
-    let c3 = 2.0 * td * (td + tj) * (2.0 * td + tj).powi(2);
+    let c3 = 2.0 * td * (td + tj) * (2.0 * td + tj) * (2.0 * td + tj);
     (c1, c2, c3)
 }
 
@@ -94,12 +94,12 @@ fn phase_a(l: &TickLimits4, td: f64, tj: f64, s6: f64) -> (f64, f64) {
     let (c1, c2, c3) = coefficients(td, tj);
     // eq 38: the positive root of c1·ta² + c2·ta + c3 − x/s = 0.
     let ta_x = (-c2 + (c2 * c2 - 4.0 * c1 * (c3 - l.x / s6)).max(0.0).sqrt()) / (2.0 * c1);
-    let mut ta = ceil_ticks(ta_x) as f64;
+    let mut ta = ceil_ticks_f(ta_x);
     // eq 40.
     let mut s = l.x / (ta * (c1 * ta + c2) + c3);
     // eqs 41–45: velocity check, v_peak = s·td·(td+tj)·(2td+tj+ta).
     if s * c1 * (2.0 * td + tj + ta) > l.v {
-        ta = ceil_ticks((l.v / s6 - c1 * (2.0 * td + tj)) / c1) as f64;
+        ta = ceil_ticks_f((l.v / s6 - c1 * (2.0 * td + tj)) / c1);
         s = l.v / (c1 * (2.0 * td + tj + ta));
     }
     (ta, s)
@@ -110,7 +110,7 @@ fn phase_v(l: &TickLimits4, td: f64, tj: f64, ta: f64, s8: f64) -> (f64, f64) {
     let (c1, c2, c3) = coefficients(td, tj);
     let moved = ta * (c1 * ta + c2) + c3;
     // eq 47: cruise time at the velocity limit for the distance left.
-    let tv = ceil_ticks((l.x - s8 * moved) / l.v) as f64;
+    let tv = ceil_ticks_f((l.x - s8 * moved) / l.v);
     // eq 49: snap from all four rounded times.
     let s = l.x / (moved + tv * c1 * (2.0 * td + tj + ta));
     (tv, s)

@@ -20,12 +20,8 @@
 //! Because the unit program's accel and decel halves cancel, jerk, acceleration and velocity
 //! end at exactly 0 for every amplitude.
 
-use core::ops::Range;
-
-use ethnum::I256;
-
 use super::PhaseTicks;
-use crate::peaks::{ExactState, Peaks};
+use crate::format::Quantity;
 use crate::program::{Program, Segment};
 
 /// Profile shapes the quantizer knows.
@@ -39,16 +35,28 @@ pub enum Shape {
     Accel2,
 }
 
-/// A short list of `(ticks, snap)` pieces, on the stack (at most 17 for these shapes).
+/// A short list of `(ticks, snap)` pieces of a unit program, on the stack (at most 17 for
+/// these shapes). Unit snaps are small (±1, ±2 where impulses coincide) and a unit program
+/// lasts fewer than 2^32 ticks (checked before it is built), so a piece is 5 bytes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Pieces {
-    items: [(u64, i128); 17],
+    items: [(u32, i8); 17],
     len: usize,
+    /// Largest |jerk| the pieces reach (from rest).
+    jerk_peak: i64,
+    /// Largest |snap| of a piece with ticks.
+    snap_peak: i64,
 }
 
 impl Pieces {
-    fn push(&mut self, piece: (u64, i128)) {
-        self.items[self.len] = piece;
+    #[inline(always)]
+    fn push(&mut self, (ticks, snap): (u64, i128)) {
+        debug_assert!(
+            ticks < 1 << 32,
+            "unit programs are checked to last < 2^32 ticks"
+        );
+        debug_assert!(snap.abs() <= 4, "unit snaps are small");
+        self.items[self.len] = (ticks as u32, snap as i8);
         self.len += 1;
     }
 
@@ -61,56 +69,51 @@ impl Pieces {
     }
 
     /// The pieces.
-    pub fn as_slice(&self) -> &[(u64, i128)] {
+    #[inline]
+    pub fn as_slice(&self) -> &[(u32, i8)] {
         &self.items[..self.len]
-    }
-
-    /// Index of the segment of `program` (built by [`Pieces::to_program`]) that is the cruise:
-    /// the zero-snap segment lying inside `cruise` (ticks from the program start, half-open)
-    /// and ending at its end, if there is one. A zero-snap segment that begins before the
-    /// cruise (an acceleration plateau joined to it, or a triangular profile with no cruise at
-    /// all) is not a cruise: cutting it would leave the axis moving.
-    pub fn cruise_segment(program: &Program, cruise: Range<u64>) -> Option<usize> {
-        let mut end = 0u64;
-        for (i, s) in program.segments.iter().enumerate() {
-            let start = end;
-            end += u64::from(s.ticks);
-            if end == cruise.end {
-                return (s.snap == 0 && start >= cruise.start && start < end).then_some(i);
-            }
-            if end > cruise.end {
-                return None;
-            }
-        }
-        None
     }
 
     /// The program with amplitude `k`: empty pieces dropped, equal neighbours joined.
     pub fn to_program(&self, k: i128) -> Program {
-        let mut out: Vec<Segment> = Vec::with_capacity(self.len);
+        let mut out = Program {
+            segments: Vec::with_capacity(self.len),
+        };
+        self.write_program(k, &mut out);
+        out
+    }
+
+    /// [`Pieces::to_program`] into `out`, reusing its memory.
+    pub fn write_program(&self, k: i128, out: &mut Program) {
+        let out = &mut out.segments;
+        out.clear();
         for &(ticks, snap) in self.as_slice() {
             if ticks == 0 {
                 continue;
             }
-            let ticks =
-                u32::try_from(ticks).expect("unit programs are checked to last < 2^32 ticks");
-            let snap = snap * k;
+            let snap = i128::from(snap) * k;
             match out.last_mut() {
                 Some(last) if last.snap == snap => last.ticks += ticks,
                 _ => out.push(Segment { ticks, snap }),
             }
         }
-        Program { segments: out }
     }
 }
 
 /// Pieces `(ticks, snap)` from one-tick snap impulses `(tick, snap)` (coinciding impulses
 /// add), zero snap between them, lasting `total` ticks.
+#[inline]
 fn impulse_pieces(impulses: &mut [(u64, i128)], total: u64) -> Pieces {
-    impulses.sort_unstable_by_key(|&(t, _)| t);
+    // The shapes list their impulses in tick order except when a phase is empty (a trapezoid
+    // without cruise); sort only then.
+    if !impulses.windows(2).all(|w| w[0].0 <= w[1].0) {
+        impulses.sort_unstable_by_key(|&(t, _)| t);
+    }
     let mut out = Pieces::default();
     let mut at = 0u64;
     let mut i = 0;
+    // The jerk only changes at an impulse: its peak is the largest prefix sum.
+    let mut jerk = 0i64;
     while i < impulses.len() {
         let t = impulses[i].0;
         let mut d = 0i128;
@@ -120,6 +123,9 @@ fn impulse_pieces(impulses: &mut [(u64, i128)], total: u64) -> Pieces {
         }
         out.push((t - at, 0));
         out.push((1, d));
+        jerk += d as i64;
+        out.jerk_peak = out.jerk_peak.max(jerk.abs());
+        out.snap_peak = out.snap_peak.max((d as i64).abs());
         at = t + 1;
     }
     out.push((total - at, 0));
@@ -128,13 +134,15 @@ fn impulse_pieces(impulses: &mut [(u64, i128)], total: u64) -> Pieces {
 
 /// The unit profile of `shape` as pieces of constant snap, one per phase (not merged, some
 /// possibly empty): every register is monotonic inside a piece.
+#[inline]
 fn unit_pieces(shape: Shape, p: &PhaseTicks) -> Pieces {
     let total = u64::try_from(unit_ticks(shape, p)).expect("checked by the caller");
     match shape {
         Shape::Snap4 => {
             let (td, tj, ta, tv) = (p.d, p.j, p.a, p.v);
             // Eq 63: snap +, 0, −, 0, −, 0, + over the accel half; the decel half negated.
-            Pieces::from_slice(&[
+            // The jerk ramps to ±td and back in each snap pair: its peak is td; the snap's is 1.
+            let mut pieces = Pieces::from_slice(&[
                 (td, 1),
                 (tj, 0),
                 (td, -1),
@@ -150,7 +158,10 @@ fn unit_pieces(shape: Shape, p: &PhaseTicks) -> Pieces {
                 (td, 1),
                 (tj, 0),
                 (td, -1),
-            ])
+            ]);
+            pieces.jerk_peak = td as i64;
+            pieces.snap_peak = 1;
+            pieces
         }
         Shape::Jerk3 => {
             // Jerk steps +, −, −, + at the phase boundaries of each half. The last impulse is
@@ -194,22 +205,6 @@ pub fn unit_program(shape: Shape, p: &PhaseTicks) -> Program {
     unit_pieces(shape, p).to_program(1)
 }
 
-/// The ticks of a unit program of `shape` during which the velocity is constant and jerk,
-/// acceleration and snap are zero (half-open, from the program start): from the end of the
-/// acceleration half (after its last snap piece or impulse) to where deceleration starts.
-/// Empty when the profile has no cruise.
-pub fn cruise_ticks(shape: Shape, p: &PhaseTicks) -> Range<u64> {
-    let (start, end) = match shape {
-        // Eq 63: the acceleration half is 4·T_d + 2·T_j + T_a ticks of pieces.
-        Shape::Snap4 => (4 * p.d + 2 * p.j + p.a, 4 * p.d + 2 * p.j + p.a + p.v),
-        // The jerk impulse at tick 2·T_j + T_a ends the acceleration half.
-        Shape::Jerk3 => (2 * p.j + p.a + 1, 2 * p.j + p.a + p.v),
-        // The acceleration step back to zero is the impulse pair at T_a, T_a + 1.
-        Shape::Accel2 => (p.a + 2, p.a + p.v),
-    };
-    start..end.max(start)
-}
-
 /// The total ticks of a unit program of `shape`, without building it.
 pub fn unit_ticks(shape: Shape, p: &PhaseTicks) -> u128 {
     let (d, j, a, v) = (
@@ -225,20 +220,46 @@ pub fn unit_ticks(shape: Shape, p: &PhaseTicks) -> u128 {
     }
 }
 
-/// What the unit program does: exact gain and peaks from rest.
+/// Exact peak magnitudes of a unit program from rest (its position peak is its gain).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UnitPeaks {
+    /// max |v|.
+    pub v: u128,
+    /// max |a|.
+    pub a: u128,
+    /// max |j|.
+    pub j: u128,
+    /// max |d|.
+    pub d: u128,
+}
+
+impl UnitPeaks {
+    /// The peak of `q` (position: none, 0).
+    pub fn get(&self, q: Quantity) -> u128 {
+        match q {
+            Quantity::Velocity => self.v,
+            Quantity::Acceleration => self.a,
+            Quantity::Jerk => self.j,
+            Quantity::Snap => self.d,
+            Quantity::Position => 0,
+        }
+    }
+}
+
+/// What the unit program does: exact gain and peaks from rest (its end is at rest, checked by
+/// the tests on an independent integration).
 #[derive(Clone, Debug)]
 pub struct UnitResponse {
     /// The unit profile's phases.
     pub pieces: Pieces,
     /// Exact end position `P` from rest at 0.
-    pub gain: I256,
+    pub gain: u128,
     /// Exact peaks from rest at 0.
-    pub peaks: Peaks,
-    /// Exact final state (j = a = v = 0 by construction; checked in tests).
-    pub end: ExactState,
+    pub peaks: UnitPeaks,
 }
 
-/// Builds and measures the unit program; `None` if a value leaves `i128` (such a move is far
+/// Builds and measures the unit program; `None` if it lasts 2^32 ticks or more or a value
+/// leaves `i128` (such a move is far
 /// outside every format: its gain is past 2^80).
 ///
 /// The discrete chain reproduces the continuous relations *exactly* for these symmetric
@@ -254,17 +275,13 @@ pub struct UnitResponse {
 /// Jerk and snap peaks are read off the phases (the jerk is linear inside each one).
 /// `unit_peaks_match_the_chain` checks all of it against a full closed-form run of the chain,
 /// and the property tests against a per-tick trace.
+#[inline]
 pub fn unit_response(shape: Shape, p: &PhaseTicks) -> Option<UnitResponse> {
-    let pieces = unit_pieces(shape, p);
-    let (mut j, mut jpk, mut dpk) = (0i128, 0i128, 0i128);
-    for &(ticks, snap) in pieces.as_slice() {
-        // ticks < 2^32 and |snap| ≤ 2: no overflow.
-        j += i128::from(ticks) * snap;
-        jpk = jpk.max(j.abs());
-        if ticks > 0 {
-            dpk = dpk.max(snap.abs());
-        }
+    if unit_ticks(shape, p) >= 1 << 32 {
+        return None;
     }
+    let pieces = unit_pieces(shape, p);
+    let (jpk, dpk) = (pieces.jerk_peak, pieces.snap_peak);
     let w = |t: u64| i128::from(t);
     let m = |a: i128, b: i128| a.checked_mul(b);
     let (a, v, x) = match shape {
@@ -286,29 +303,31 @@ pub fn unit_response(shape: Shape, p: &PhaseTicks) -> Option<UnitResponse> {
     };
     Some(UnitResponse {
         pieces,
-        gain: I256::from(x),
-        peaks: Peaks {
-            x: I256::from(x),
-            v: I256::from(v),
-            a: I256::from(a),
-            j: I256::from(jpk),
-            d: I256::from(dpk),
-        },
-        end: ExactState {
-            x: I256::from(x),
-            ..Default::default()
+        gain: x as u128,
+        peaks: UnitPeaks {
+            v: v as u128,
+            a: a as u128,
+            j: jpk as u128,
+            d: dpk as u128,
         },
     })
-}
-
-/// `ceil(x / p)` for `x ≥ 0`, `p > 0`.
-pub fn div_ceil(x: I256, p: I256) -> I256 {
-    (x + p - 1) / p
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ethnum::I256;
+
+    /// `program` integrated from rest by snapgen-verify.
+    fn integrate_from_rest(program: &Program) -> snapgen_verify::Integration {
+        snapgen_verify::integrate(
+            snapgen_verify::State::default(),
+            program
+                .segments
+                .iter()
+                .map(|s| (u64::from(s.ticks), s.snap)),
+        )
+    }
 
     #[test]
     fn unit_programs_end_at_rest() {
@@ -370,13 +389,16 @@ mod tests {
         ] {
             let u = unit_response(shape, &p).unwrap();
             let program = u.pieces.to_program(1);
+            // Integrated independently (snapgen-verify), not read off the unit response.
+            let r = integrate_from_rest(&program);
+            assert!(r.end.at_rest(), "{shape:?} {p:?}: {:?}", r.end);
+            assert!(r.end.x > 0, "{shape:?} {p:?}");
             assert_eq!(
-                (u.end.v, u.end.a, u.end.j),
-                (I256::ZERO, I256::ZERO, I256::ZERO),
-                "{shape:?} {p:?}"
+                r.end.x,
+                I256::from(u.gain),
+                "{shape:?} {p:?}: the gain is where it ends"
             );
-            assert!(u.gain > 0, "{shape:?} {p:?}");
-            assert_eq!(program.total_ticks() as u128, unit_ticks(shape, &p));
+            assert_eq!(u128::from(r.ticks), unit_ticks(shape, &p));
         }
     }
 
@@ -400,10 +422,23 @@ mod tests {
                                 v,
                             };
                             let u = unit_response(shape, &p).unwrap();
-                            let (full, end) =
-                                peaks(&u.pieces.to_program(1), &ChainState::default());
-                            assert_eq!(u.peaks, full, "{shape:?} {p:?}");
-                            assert_eq!(u.end, end);
+                            let program = u.pieces.to_program(1);
+                            let (full, _) = peaks(&program, &ChainState::default());
+                            let pk = u.peaks;
+                            assert_eq!(
+                                [pk.v, pk.a, pk.j, pk.d].map(I256::from),
+                                [full.v, full.a, full.j, full.d],
+                                "{shape:?} {p:?}"
+                            );
+                            assert_eq!(I256::from(u.gain), full.x);
+                            // And against the independent integration (snapgen-verify).
+                            let r = integrate_from_rest(&program);
+                            let ext = [0, 1, 2, 3, 4].map(|k| r.range(k).max_abs());
+                            assert_eq!(
+                                ext,
+                                [u.gain, pk.v, pk.a, pk.j, pk.d].map(I256::from),
+                                "{shape:?} {p:?}"
+                            );
                         }
                     }
                 }
@@ -421,8 +456,8 @@ mod tests {
             v: 2,
         };
         let u = unit_response(Shape::Snap4, &p).unwrap();
-        assert_eq!(u.peaks.j, I256::from(5));
-        assert_eq!(u.peaks.a, I256::from(5 * (5 + 3)));
+        assert_eq!(u.peaks.j, 5);
+        assert_eq!(u.peaks.a, 5 * (5 + 3));
         // 16 switching times (eq 53) bound 15 segments.
         assert_eq!(u.pieces.to_program(1).segments.len(), 15);
     }

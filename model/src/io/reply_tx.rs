@@ -1,0 +1,235 @@
+//! The fabric's reply transmitter (`snapgen_hdl::reply_tx::ReplyTx`), clock by clock. When idle
+//! it takes the next queued reply, or else a pending telemetry frame, reads its payload from the
+//! live values at that clock (docs/PROTOCOL.md: a reply reports the device as it is when the
+//! reply starts), and writes the frame — start byte, length, code, sequence, payload, CRC low
+//! then high — into the transmit FIFO one byte per clock while the FIFO is not full. Frames are
+//! never interleaved; telemetry waits while a reply is queued.
+
+use crate::io::executor::{Config, ReplyDesc, ReplyKind};
+use crate::protocol::{crc16_step, Identity, Param, Reply, StateReply, Status, CRC_INIT, START};
+
+/// What the payloads are read from (the live values of the clock a reply starts).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Live {
+    /// The status block.
+    pub status: Status,
+    /// The registers and their tick.
+    pub state: StateReply,
+    /// The configuration.
+    pub config: Config,
+    /// The design's constant identity (its tick divider and stop limits are taken from
+    /// `config`).
+    pub identity: Identity,
+}
+
+impl Live {
+    /// The reply `d` stands for.
+    pub fn reply(&self, d: &ReplyDesc) -> Reply {
+        match d.kind {
+            ReplyKind::Identity => Reply::Identity(Identity {
+                tick_divider: self.config.tick_div,
+                stop: self.config.stop,
+                ..self.identity
+            }),
+            ReplyKind::Ack => Reply::Ack { cmd: d.cmd },
+            ReplyKind::Nak => Reply::Nak {
+                cmd: d.cmd,
+                reason: crate::protocol::Reason::from_byte(d.aux)
+                    .expect("the executor queues known reasons"),
+            },
+            ReplyKind::Status => Reply::Status(self.status),
+            ReplyKind::State => Reply::State(self.state),
+            ReplyKind::Config => {
+                let param = Param::from_byte(d.aux).expect("the executor checked it");
+                Reply::Config {
+                    param,
+                    value: self.config.get(param),
+                }
+            }
+            ReplyKind::Telemetry => Reply::Telemetry(self.status),
+        }
+    }
+}
+
+/// Inputs of one clock.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReplyTxInputs {
+    /// Synchronous reset.
+    pub reset: bool,
+    /// The reply queue's head.
+    pub head: Option<ReplyDesc>,
+    /// Pulse: send telemetry.
+    pub telemetry: bool,
+    /// The transmit FIFO is full.
+    pub fifo_full: bool,
+}
+
+/// What the transmitter does this clock (combinational from its state and inputs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReplyTxOutputs {
+    /// Take the queue's head now.
+    pub pop: bool,
+    /// Write `fifo_data` into the transmit FIFO now.
+    pub fifo_write: bool,
+    /// The byte.
+    pub fifo_data: u8,
+}
+
+/// The transmitter.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ReplyTx {
+    active: bool,
+    index: u8,
+    len: u8,
+    code: u8,
+    seq: u8,
+    payload: Vec<u8>,
+    crc: u16,
+    telemetry_pending: bool,
+}
+
+impl ReplyTx {
+    /// Idle.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// True while a frame is being written.
+    pub fn busy(&self) -> bool {
+        self.active
+    }
+
+    /// The byte at the current index.
+    fn byte(&self) -> u8 {
+        let (k, n) = (self.index, self.len);
+        match k {
+            0 => START,
+            1 => n,
+            2 => self.code,
+            3 => self.seq,
+            _ if k < n + 4 => self.payload[usize::from(k - 4)],
+            _ if k == n + 4 => self.crc as u8,
+            _ => (self.crc >> 8) as u8,
+        }
+    }
+
+    /// What it does this clock, before the edge.
+    pub fn outputs(&self, i: &ReplyTxInputs) -> ReplyTxOutputs {
+        ReplyTxOutputs {
+            pop: !i.reset && !self.active && i.head.is_some(),
+            fifo_write: !i.reset && self.active && !i.fifo_full,
+            fifo_data: self.byte(),
+        }
+    }
+
+    /// One clock, with the live values of this clock.
+    pub fn clock(&mut self, i: &ReplyTxInputs, live: &Live) -> ReplyTxOutputs {
+        let out = self.outputs(i);
+        if i.reset {
+            *self = ReplyTx::new();
+            return out;
+        }
+        let mut launched_telemetry = false;
+        if !self.active {
+            let d = match i.head {
+                Some(d) => Some(d),
+                None if self.telemetry_pending || i.telemetry => {
+                    launched_telemetry = true;
+                    Some(ReplyDesc {
+                        kind: ReplyKind::Telemetry,
+                        ..Default::default()
+                    })
+                }
+                None => None,
+            };
+            if let Some(d) = d {
+                let frame = live.reply(&d).to_frame(d.seq);
+                self.active = true;
+                self.index = 0;
+                self.len = frame.payload.len() as u8;
+                self.code = frame.cmd;
+                self.seq = frame.seq;
+                self.payload = frame.payload;
+                self.crc = CRC_INIT;
+            }
+        } else if out.fifo_write {
+            let (k, n) = (self.index, self.len);
+            if k >= 1 && k < n + 4 {
+                self.crc = crc16_step(self.crc, out.fifo_data);
+            }
+            self.index += 1;
+            if k == n + 5 {
+                self.active = false;
+            }
+        }
+        if launched_telemetry {
+            self.telemetry_pending = false;
+        }
+        if i.telemetry && !launched_telemetry {
+            self.telemetry_pending = true;
+        }
+        out
+    }
+}
+
+/// The status block of the I/O top, from the registered values of its blocks.
+#[derive(Clone, Copy, Debug)]
+pub struct StatusInputs<'a> {
+    /// The executor's outputs.
+    pub exec: &'a crate::io::executor::ExecutorOutputs,
+    /// The core's outputs.
+    pub core: &'a crate::CoreOutputs,
+    /// Velocity register width.
+    pub v_bits: u32,
+    /// The encoder count.
+    pub encoder: i64,
+    /// An illegal encoder transition was seen.
+    pub encoder_error: bool,
+    /// Limit and emergency-stop inputs (filtered, polarity applied).
+    pub limit_positive: bool,
+    /// Negative limit.
+    pub limit_negative: bool,
+    /// Emergency stop.
+    pub emergency_stop: bool,
+    /// The controller's outputs.
+    pub servo: &'a crate::io::servo::ServoOutputs,
+}
+
+/// The status block.
+pub fn status(s: &StatusInputs) -> Status {
+    use crate::protocol::flag;
+    let (e, c) = (s.exec, s.core);
+    let mut flags = 0u16;
+    for (on, bit) in [
+        (c.busy, flag::PLAYING),
+        (c.done, flag::DONE),
+        (c.aborted, flag::CUT),
+        (c.stopping, flag::STOPPING),
+        (c.stop_over, flag::STOP_OVER_LIMITS),
+        (e.amplifier, flag::AMPLIFIER),
+        (s.limit_positive, flag::LIMIT_POSITIVE),
+        (s.limit_negative, flag::LIMIT_NEGATIVE),
+        (s.emergency_stop, flag::EMERGENCY_STOP),
+        (s.encoder_error, flag::ENCODER_ERROR),
+        (e.uart_error, flag::UART_ERROR),
+        (e.reply_overflow, flag::REPLY_OVERFLOW),
+        (e.servo_overrun, flag::SERVO_OVERRUN),
+    ] {
+        if on {
+            flags |= bit;
+        }
+    }
+    Status {
+        state: e.state as u8,
+        error: e.error as u8,
+        flags,
+        tick_count: c.tick_count,
+        position: c.position as i32,
+        velocity: (c.v >> (s.v_bits - 32)) as i32,
+        encoder: s.encoder as i32,
+        bad_crc: e.bad_crc,
+        bad_frames: e.bad_frames,
+        following_peak: s.servo.peak,
+        duty: s.servo.duty,
+    }
+}
