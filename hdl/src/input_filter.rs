@@ -15,8 +15,8 @@ pub struct InputFilter {
     pub filter: Signal<In, Bits<16>>,
     /// The filtered level.
     pub level: Signal<Out, Bit>,
-    s1: DFFWithInit<Bit>,
-    s2: DFFWithInit<Bit>,
+    sync1: DFFWithInit<Bit>,
+    sync2: DFFWithInit<Bit>,
     level_reg: DFFWithInit<Bit>,
     count: DFF<Bits<16>>,
     zero: Constant<Bits<16>>,
@@ -31,8 +31,8 @@ impl InputFilter {
             pin: Default::default(),
             filter: Default::default(),
             level: Default::default(),
-            s1: DFFWithInit::new(idle),
-            s2: DFFWithInit::new(idle),
+            sync1: DFFWithInit::new(idle),
+            sync2: DFFWithInit::new(idle),
             level_reg: DFFWithInit::new(idle),
             count: Default::default(),
             zero: Constant::new(0.into()),
@@ -44,13 +44,13 @@ impl InputFilter {
 impl Logic for InputFilter {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, s1, s2, level_reg, count);
-        self.s1.d.next = self.pin.val();
-        self.s2.d.next = self.s1.q.val();
-        if self.s2.q.val() == self.level_reg.q.val() {
+        dff_setup!(self, clock, sync1, sync2, level_reg, count);
+        self.sync1.d.next = self.pin.val();
+        self.sync2.d.next = self.sync1.q.val();
+        if self.sync2.q.val() == self.level_reg.q.val() {
             self.count.d.next = self.zero.val();
         } else if self.count.q.val() >= self.filter.val() {
-            self.level_reg.d.next = self.s2.q.val();
+            self.level_reg.d.next = self.sync2.q.val();
             self.count.d.next = self.zero.val();
         } else {
             self.count.d.next = self.count.q.val() + self.one.val();
@@ -65,10 +65,6 @@ mod tests {
 
     #[test]
     fn input_filter_is_synthesizable() {
-        let mut uut = InputFilter::new(true);
-        uut.connect_all();
-        let v = crate::verilog::direct_clocks(&generate_verilog(&uut));
-        yosys_validate("input_filter", &v).unwrap();
-        crate::synth_check::synth_xilinx("input_filter", &v);
+        crate::synth_check::synth_block("input_filter", InputFilter::new(true));
     }
 }

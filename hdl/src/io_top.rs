@@ -1,55 +1,115 @@
-//! The top-level core: the motion core behind the UART command interface, with the encoder
-//! decoder and the PWM generator (what a board top instantiates; `snapgen verilog --top io`).
+//! The I/O top: the motion core behind the UART command interface, with the encoder decoder,
+//! the PWM generator, the limit-switch and emergency-stop inputs and the amplifier enable (what
+//! a board top instantiates; `snapgen_io.v`). Its reference, clock for clock, is
+//! `snapgen_model::device::Device`.
 //!
 //! ```text
-//! uart_rx → UartRx → ByteFifo → FrameRx → Executor → MotionCore
-//!                                  │          │ status
-//! uart_tx ← UartTx ← ByteFifo ← ReplyTx ←─────┘
-//! enc_a/b/i → QuadratureDecoder → encoder count (status, PWM)
-//! pwm/dir ← PwmGenerator (duty = position − encoder count, saturated: a unity-gain
-//!           proportional position loop; period set by CONFIGURE)
+//! uart_rx → UartRx → ByteFifo → FrameRx → Executor ─→ MotionCore (sequencer, stop unit, chain)
+//!                                           │  ↑ status, registers
+//!                                           ↓  │
+//! uart_tx ← UartTx ← ByteFifo ← ReplyTx ← ReplyQueue        StatusBlock → status
+//! enc_a/b/i → QuadratureDecoder → encoder count;  limit±, e-stop → InputFilter → Executor
+//! chain x, v, a + encoder count → Servo (PID + feed-forward, following-error limit) → duty
+//! pwm/dir ← PwmGenerator (off while the amplifier is disabled);  amplifier
 //! ```
 //!
-//! LEDs: 0 idle, 1 busy, 2 fault (aborted, a UART framing error or an encoder error seen),
-//! 3 heartbeat.
+//! LEDs: idle, busy (a program plays or a stop runs), fault (ErrorStop, a UART framing error or
+//! an encoder error seen), heartbeat. `status` is the status block as the device would report
+//! it now: for co-simulation and debugging (a board top may leave it open; synthesis trims it).
 
 use rust_hdl::prelude::*;
+use snapgen_model::device::Design;
+use snapgen_model::protocol::AxisState;
+use snapgen_model::timing::{Dividers, Timing};
 
 use crate::byte_fifo::ByteFifo;
 use crate::core::MotionCore;
 use crate::executor::Executor;
 use crate::frame_rx::FrameRx;
+use crate::input_filter::InputFilter;
 use crate::pwm::PwmGenerator;
 use crate::quadrature::QuadratureDecoder;
+use crate::reply_queue::ReplyQueue;
 use crate::reply_tx::ReplyTx;
+use crate::servo::Servo;
+use crate::status_block::{StatusBlock, STATUS_BITS};
 use crate::uart_rx::UartRx;
 use crate::uart_tx::UartTx;
+use crate::verilog::{Note, Waiver};
 
-/// Top-level settings fixed at generation.
-#[derive(Clone, Copy, Debug)]
-pub struct IoTopConfig {
-    /// Fabric clocks per UART bit (1085: 115 200 baud at 125 MHz).
-    pub uart_divisor: u16,
-    /// Inter-byte timeout in clocks (2 500 000: 20 ms at 125 MHz).
-    pub frame_timeout: u32,
-    /// Tick divider after reset (1249: Ts = 10 µs at 125 MHz).
-    pub tick_div: u32,
-    /// Heartbeat LED: bit of a free-running counter (26: ~1 Hz at 125 MHz).
-    pub heartbeat_bit: usize,
-}
+const _: () = assert!(
+    crate::servo::REFERENCE_LOW == 64
+        && crate::servo::VELOCITY_LOW == 48
+        && crate::servo::ACCEL_LOW == 40
+);
 
-impl Default for IoTopConfig {
-    fn default() -> Self {
-        IoTopConfig {
-            uart_divisor: snapgen_model::io::uart::DIVISOR_115200_AT_125MHZ,
-            frame_timeout: 2_500_000,
-            tick_div: 1249,
-            heartbeat_bit: 26,
-        }
+/// Lint waivers of the I/O top, written into its Verilog beside each declaration.
+pub const WAIVERS: [Waiver; 8] = [
+    unused(
+        "encoder_index_seen",
+        "the index pulse is counted for a later homing command",
+    ),
+    unused(
+        "encoder_index_count",
+        "the index pulse is counted for a later homing command",
+    ),
+    unused(
+        "rx_fifo_full",
+        "the frame receiver takes a byte every clock: it never fills",
+    ),
+    unused(
+        "core_active_bank",
+        "the bank is internal to the core; the status reports playing/done",
+    ),
+    unused(
+        "core_segment",
+        "the status reports ticks and position, not the segment index",
+    ),
+    unused(
+        "core_stop_over",
+        "reported through the status block's STOP_OVER_LIMITS flag input",
+    ),
+    unused(
+        "core_v",
+        "the status reports the velocity register's top 32 bits",
+    ),
+    unused(
+        "exec_input_polarity",
+        "bit by bit: each input's polarity is one bit of it",
+    ),
+];
+
+const fn unused(signal: &'static str, reason: &'static str) -> Waiver {
+    Waiver {
+        module: "",
+        signal,
+        note: Note::LintOff("UNUSEDSIGNAL"),
+        reason,
     }
 }
 
-/// The top-level core.
+/// The dividers for 125 MHz, 115 200 baud and Ts = 10 µs (the Zybo Z7-10 defaults).
+pub fn default_dividers() -> Dividers {
+    Timing::default()
+        .dividers()
+        .expect("the default timing is valid")
+}
+
+/// The default design (the Zybo Z7-10's timing, the default format), with design hash 0:
+/// [`crate::verilog::io_design`] computes a design's real hash.
+pub fn default_design() -> Design {
+    let t = Timing::default();
+    Design {
+        format: snapgen_model::DEFAULT_FORMAT,
+        dividers: default_dividers(),
+        clock_hz: t.clock_hz as u32,
+        baud: t.baud,
+        design_hash: 0,
+        input_polarity: 0,
+    }
+}
+
+/// The I/O top.
 #[derive(LogicBlock)]
 pub struct IoTop {
     /// Fabric clock.
@@ -58,18 +118,26 @@ pub struct IoTop {
     pub reset: Signal<In, Bit>,
     /// UART receive pin.
     pub uart_rx: Signal<In, Bit>,
-    /// UART transmit pin.
-    pub uart_tx: Signal<Out, Bit>,
     /// Encoder channel A.
     pub enc_a: Signal<In, Bit>,
     /// Encoder channel B.
     pub enc_b: Signal<In, Bit>,
     /// Encoder index.
     pub enc_i: Signal<In, Bit>,
+    /// Positive limit switch (polarity set by INPUT_POLARITY).
+    pub limit_pos: Signal<In, Bit>,
+    /// Negative limit switch.
+    pub limit_neg: Signal<In, Bit>,
+    /// Emergency stop.
+    pub estop: Signal<In, Bit>,
+    /// UART transmit pin.
+    pub uart_tx: Signal<Out, Bit>,
     /// PWM output.
     pub pwm: Signal<Out, Bit>,
     /// Direction output.
     pub dir: Signal<Out, Bit>,
+    /// Amplifier enable (low: the amplifier must not drive the motor).
+    pub amplifier: Signal<Out, Bit>,
     /// LED 0: idle.
     pub led_idle: Signal<Out, Bit>,
     /// LED 1: busy.
@@ -78,92 +146,97 @@ pub struct IoTop {
     pub led_fault: Signal<Out, Bit>,
     /// LED 3: heartbeat.
     pub led_heartbeat: Signal<Out, Bit>,
-    /// The reference position in output LSBs, for simulation (a virtual board's encoder
-    /// follows it) and a future motor model; a board top leaves it unconnected.
-    pub ref_position: Signal<Out, Bits<32>>,
+    /// The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits
+    /// 7:0: for co-simulation and debugging.
+    pub status: Signal<Out, Bits<STATUS_BITS>>,
     uart_in: UartRx,
+    rx_fifo: ByteFifo,
     frames: FrameRx,
     exec: Executor,
     core: MotionCore,
-    replies: ReplyTx,
-    fifo: ByteFifo,
-    rx_fifo: ByteFifo,
+    queue: ReplyQueue,
+    reply_tx: ReplyTx,
+    tx_fifo: ByteFifo,
     uart_out: UartTx,
     encoder: QuadratureDecoder<32>,
     pwm_gen: PwmGenerator,
+    servo: Servo,
+    status_block: StatusBlock,
+    limit_pos_in: InputFilter,
+    limit_neg_in: InputFilter,
+    estop_in: InputFilter,
     heartbeat: DFF<Bits<32>>,
-    error: Signal<Local, Bits<32>>,
-    duty: Signal<Local, Bits<16>>,
+    limit_pos_seen: Signal<Local, Bit>,
+    limit_neg_seen: Signal<Local, Bit>,
+    estop_seen: Signal<Local, Bit>,
+    encoder_error: Signal<Local, Bit>,
     divisor: Constant<Bits<16>>,
     timeout: Constant<Bits<32>>,
-    tick_div_default: Constant<Bits<32>>,
     beat_mask: Constant<Bits<32>>,
     one: Constant<Bits<32>>,
     zero32: Constant<Bits<32>>,
-    zero17: Constant<Bits<17>>,
-    ones17: Constant<Bits<17>>,
-    duty_max: Constant<Bits<16>>,
-    duty_min: Constant<Bits<16>>,
-    zero8: Constant<Bits<8>>,
     zero16: Constant<Bits<16>>,
-    state_busy: Constant<Bits<8>>,
-    state_done: Constant<Bits<8>>,
-    state_aborted: Constant<Bits<8>>,
+    error_stop: Constant<Bits<3>>,
 }
 
 impl IoTop {
-    /// The top with these settings.
-    pub fn new(cfg: IoTopConfig) -> Self {
+    /// The top for `design` (its dividers, and its identity for PING).
+    pub fn new(design: Design) -> Self {
+        let cfg = design.dividers;
         IoTop {
             clock: Default::default(),
             reset: Default::default(),
             uart_rx: Default::default(),
-            uart_tx: Default::default(),
             enc_a: Default::default(),
             enc_b: Default::default(),
             enc_i: Default::default(),
+            limit_pos: Default::default(),
+            limit_neg: Default::default(),
+            estop: Default::default(),
+            uart_tx: Default::default(),
             pwm: Default::default(),
             dir: Default::default(),
+            amplifier: Default::default(),
             led_idle: Default::default(),
             led_busy: Default::default(),
             led_fault: Default::default(),
             led_heartbeat: Default::default(),
-            ref_position: Default::default(),
+            status: Default::default(),
             uart_in: Default::default(),
-            frames: Default::default(),
-            exec: Default::default(),
-            core: Default::default(),
-            replies: Default::default(),
-            fifo: Default::default(),
             rx_fifo: Default::default(),
+            frames: Default::default(),
+            exec: Executor::new(cfg, design.input_polarity),
+            core: Default::default(),
+            queue: Default::default(),
+            reply_tx: ReplyTx::new(design.identity()),
+            tx_fifo: Default::default(),
             uart_out: Default::default(),
             encoder: Default::default(),
             pwm_gen: Default::default(),
+            servo: Default::default(),
+            status_block: Default::default(),
+            limit_pos_in: InputFilter::new(false),
+            limit_neg_in: InputFilter::new(false),
+            estop_in: InputFilter::new(false),
             heartbeat: Default::default(),
-            error: Default::default(),
-            duty: Default::default(),
+            limit_pos_seen: Default::default(),
+            limit_neg_seen: Default::default(),
+            estop_seen: Default::default(),
+            encoder_error: Default::default(),
             divisor: Constant::new(u64::from(cfg.uart_divisor).into()),
             timeout: Constant::new(u64::from(cfg.frame_timeout).into()),
-            tick_div_default: Constant::new(u64::from(cfg.tick_div).into()),
             beat_mask: Constant::new((1u64 << cfg.heartbeat_bit).into()),
             one: Constant::new(1.into()),
             zero32: Constant::new(0.into()),
-            zero17: Constant::new(0.into()),
-            ones17: Constant::new(0x1FFFF.into()),
-            duty_max: Constant::new(0x7FFF.into()),
-            duty_min: Constant::new(0x8000.into()),
-            zero8: Constant::new(0.into()),
             zero16: Constant::new(0.into()),
-            state_busy: Constant::new(1.into()),
-            state_done: Constant::new(2.into()),
-            state_aborted: Constant::new(4.into()),
+            error_stop: Constant::new((AxisState::ErrorStop as u64).into()),
         }
     }
 }
 
 impl Default for IoTop {
     fn default() -> Self {
-        IoTop::new(IoTopConfig::default())
+        IoTop::new(default_design())
     }
 }
 
@@ -171,23 +244,51 @@ impl Logic for IoTop {
     #[hdl_gen]
     fn update(&mut self) {
         clock!(
-            self, clock, uart_in, rx_fifo, frames, exec, core, replies, fifo, uart_out, encoder,
-            pwm_gen
+            self,
+            clock,
+            uart_in,
+            rx_fifo,
+            frames,
+            exec,
+            core,
+            queue,
+            reply_tx,
+            tx_fifo,
+            uart_out,
+            encoder,
+            pwm_gen,
+            servo,
+            limit_pos_in,
+            limit_neg_in,
+            estop_in
         );
         dff_setup!(self, clock, heartbeat);
         self.heartbeat.d.next = self.heartbeat.q.val() + self.one.val();
-        // Receive path.
+        // Receive path: received bytes pass through a small FIFO; the frame receiver takes
+        // one per clock.
         self.uart_in.rx.next = self.uart_rx.val();
         self.uart_in.divisor.next = self.divisor.val();
-        self.frames.reset.next = self.reset.val();
-        // Received bytes pass through a small FIFO; the frame receiver takes one per clock.
         self.rx_fifo.write.next = self.uart_in.valid.val();
         self.rx_fifo.write_data.next = self.uart_in.data.val();
         self.rx_fifo.read.next = !self.rx_fifo.empty.val();
+        self.frames.reset.next = self.reset.val();
         self.frames.data.next = self.rx_fifo.data.val();
         self.frames.valid.next = !self.rx_fifo.empty.val();
         self.frames.line_error.next = self.uart_in.framing_error.val();
         self.frames.timeout.next = self.timeout.val();
+        // Limit switches and the emergency stop: synchronised, filtered, polarity applied.
+        self.limit_pos_in.pin.next = self.limit_pos.val();
+        self.limit_neg_in.pin.next = self.limit_neg.val();
+        self.estop_in.pin.next = self.estop.val();
+        self.limit_pos_in.filter.next = self.exec.input_filter.val();
+        self.limit_neg_in.filter.next = self.exec.input_filter.val();
+        self.estop_in.filter.next = self.exec.input_filter.val();
+        self.limit_pos_seen.next =
+            self.limit_pos_in.level.val() ^ self.exec.input_polarity.val().get_bit(0);
+        self.limit_neg_seen.next =
+            self.limit_neg_in.level.val() ^ self.exec.input_polarity.val().get_bit(1);
+        self.estop_seen.next =
+            self.estop_in.level.val() ^ self.exec.input_polarity.val().get_bit(2);
         // Executor.
         self.exec.reset.next = self.reset.val();
         self.exec.frame.next = self.frames.frame.val();
@@ -197,102 +298,142 @@ impl Logic for IoTop {
         self.exec.cmd.next = self.frames.cmd.val();
         self.exec.seq.next = self.frames.seq.val();
         self.exec.len.next = self.frames.len.val();
-        self.exec.seg_index.next = self.frames.seg_index.val();
-        self.exec.seg_ticks.next = self.frames.seg_ticks.val();
-        self.exec.seg_snap.next = self.frames.seg_snap.val();
-        self.exec.commit_count.next = self.frames.commit_count.val();
-        self.exec.commit_first.next = self.frames.commit_first.val();
-        self.exec.cfg_param.next = self.frames.cfg_param.val();
-        self.exec.cfg_value.next = self.frames.cfg_value.val();
+        self.exec.payload.next = self.frames.payload.val();
+        self.exec.crc.next = self.frames.crc.val();
         self.exec.busy.next = self.core.busy.val();
-        self.exec.tick.next = self.core.tick.val();
+        self.exec.stopping.next = self.core.stopping.val();
         self.exec.standby_count.next = self.core.standby_count.val();
-        self.exec.tick_div_default.next = self.tick_div_default.val();
+        self.exec.tick.next = self.core.tick.val();
+        self.exec.at_rest.next = self.core.at_rest.val();
+        self.exec.encoder_errors.next = self.encoder.errors.val();
+        self.exec.following_fault.next = self.servo.fault.val();
+        self.exec.servo_overrun_in.next = self.servo.overrun.val();
+        self.exec.read_param.next = self.queue.head_aux.val();
+        self.exec.heading_pos.next = self.core.heading_pos.val();
+        self.exec.heading_neg.next = self.core.heading_neg.val();
+        self.exec.queue_full.next = self.queue.full.val();
+        self.exec.limit_pos.next = self.limit_pos_seen.val();
+        self.exec.limit_neg.next = self.limit_neg_seen.val();
+        self.exec.estop.next = self.estop_seen.val();
         // Motion core.
         self.core.reset.next = self.reset.val();
         self.core.tick_div.next = self.exec.tick_div.val();
         self.core.start.next = self.exec.start.val();
+        self.core.abort_move.next = self.exec.abort_move.val();
         self.core.stop.next = self.exec.stop.val();
+        self.core.load.next = self.exec.load.val();
+        self.core.load_position.next = self.encoder.count.val();
+        self.core.stop_jerk.next = self.exec.stop_jerk.val();
+        self.core.stop_accel.next = self.exec.stop_accel.val();
         self.core.write_enable.next = self.exec.write_enable.val();
         self.core.write_address.next = self.exec.write_address.val();
         self.core.write_ticks.next = self.exec.write_ticks.val();
         self.core.write_snap.next = self.exec.write_snap.val();
         self.core.count_enable.next = self.exec.count_enable.val();
         self.core.count_value.next = self.exec.count_value.val();
-        self.core.cruise_value.next = self.exec.cruise_value.val();
-        self.core.soft_stop.next = self.exec.soft_stop.val();
         // Encoder.
         self.encoder.a.next = self.enc_a.val();
         self.encoder.b.next = self.enc_b.val();
         self.encoder.index.next = self.enc_i.val();
-        self.encoder.filter.next = self.exec.encoder_filter.val().get_bits::<16>(0);
+        self.encoder.filter.next = self.exec.encoder_filter.val();
         self.encoder.clear.next = self.reset.val();
+        // Encoder errors since reset or the last RESET command.
+        self.encoder_error.next = self.encoder.errors.val() != self.exec.encoder_errors_seen.val();
+        // The status block.
+        self.status_block.state.next = self.exec.state.val();
+        self.status_block.error.next = self.exec.error.val();
+        self.status_block.playing.next = self.core.busy.val();
+        self.status_block.done.next = self.core.done.val();
+        self.status_block.cut.next = self.core.aborted.val();
+        self.status_block.stopping.next = self.core.stopping.val();
+        self.status_block.stop_over.next = self.core.stop_over.val();
+        self.status_block.amplifier.next = self.exec.amplifier.val();
+        self.status_block.limit_pos.next = self.limit_pos_seen.val();
+        self.status_block.limit_neg.next = self.limit_neg_seen.val();
+        self.status_block.estop.next = self.estop_seen.val();
+        self.status_block.encoder_error.next = self.encoder_error.val();
+        self.status_block.uart_error.next = self.exec.uart_error.val();
+        self.status_block.reply_overflow.next = self.exec.reply_overflow.val();
+        self.status_block.servo_overrun.next = self.exec.servo_overrun.val();
+        self.status_block.following_peak.next = self.servo.peak.val();
+        self.status_block.duty.next = self.servo.duty.val();
+        self.status_block.tick_count.next = self.core.tick_count.val();
+        self.status_block.position.next = self.core.position.val();
+        // rust-hdl workaround: the bit index is a literal (`#[hdl_gen]` copies const names
+        // into the Verilog); the top 32 of the 104-bit velocity register.
+        self.status_block.velocity.next = self.core.v.val().get_bits::<32>(72);
+        self.status_block.encoder.next = self.encoder.count.val();
+        self.status_block.bad_crc.next = self.exec.bad_crc_count.val();
+        self.status_block.bad_frames.next = self.exec.bad_frames_count.val();
+        self.status.next = self.status_block.status.val();
         // Replies and telemetry.
-        self.replies.reset.next = self.reset.val();
-        self.replies.request.next = self.exec.reply.val();
-        self.replies.kind.next = self.exec.reply_kind.val();
-        self.replies.cmd.next = self.exec.reply_cmd.val();
-        self.replies.seq.next = self.exec.reply_seq.val();
-        self.replies.reason.next = self.exec.reply_reason.val();
-        self.replies.telemetry.next = self.exec.telemetry.val();
-        self.replies.state.next = self.zero8.val();
-        if self.core.busy.val() {
-            self.replies.state.next = self.state_busy.val();
-        }
-        if self.core.done.val() {
-            self.replies.state.next = self.state_done.val();
-        }
-        if self.core.aborted.val() {
-            self.replies.state.next = self.state_aborted.val();
-        }
-        // Error flags: bit 0 encoder error seen, bit 1 UART framing error seen.
-        if self.encoder.errors.val() != self.zero16.val() {
-            self.replies.errors.next = self.exec.errors.val() | self.state_busy.val();
-        } else {
-            self.replies.errors.next = self.exec.errors.val();
-        }
-        self.replies.tick_count.next = self.core.tick_count.val();
-        self.replies.position.next = self.core.position.val();
-        self.replies.velocity.next = self.core.v.val().get_bits::<32>(72);
-        self.replies.encoder.next = self.encoder.count.val();
-        self.replies.bad_crc.next = self.exec.bad_crc_count.val();
-        self.replies.bad_frames.next = self.exec.bad_frames_count.val();
-        self.replies.x.next = self.core.x.val();
-        self.replies.fifo_full.next = self.fifo.full.val();
+        self.queue.reset.next = self.reset.val();
+        self.queue.push.next = self.exec.reply.val();
+        self.queue.push_kind.next = self.exec.reply_kind.val();
+        self.queue.push_cmd.next = self.exec.reply_cmd.val();
+        self.queue.push_seq.next = self.exec.reply_seq.val();
+        self.queue.push_aux.next = self.exec.reply_aux.val();
+        self.queue.pop.next = self.reply_tx.pop.val();
+        self.reply_tx.reset.next = self.reset.val();
+        self.reply_tx.head_valid.next = self.queue.head_valid.val();
+        self.reply_tx.head_kind.next = self.queue.head_kind.val();
+        self.reply_tx.head_cmd.next = self.queue.head_cmd.val();
+        self.reply_tx.head_seq.next = self.queue.head_seq.val();
+        self.reply_tx.head_aux.next = self.queue.head_aux.val();
+        self.reply_tx.telemetry.next = self.exec.telemetry.val();
+        self.reply_tx.fifo_full.next = self.tx_fifo.full.val();
+        self.reply_tx.status.next = self.status_block.status.val();
+        self.reply_tx.tick_div.next = self.exec.tick_div.val();
+        self.reply_tx.stop_jerk.next = self.exec.stop_jerk.val();
+        self.reply_tx.stop_accel.next = self.exec.stop_accel.val();
+        self.reply_tx.config_value.next = self.exec.read_value.val();
+        self.reply_tx.ticks.next = self.core.ticks.val();
+        self.reply_tx.x.next = self.core.x.val();
+        self.reply_tx.v.next = self.core.v.val();
+        self.reply_tx.a.next = self.core.a.val();
+        self.reply_tx.j.next = self.core.j.val();
         // Transmit path: FIFO into the UART.
-        self.fifo.write.next = self.replies.fifo_write.val();
-        self.fifo.write_data.next = self.replies.fifo_data.val();
-        self.fifo.read.next = !self.fifo.empty.val() & !self.uart_out.busy.val();
-        self.uart_out.start.next = !self.fifo.empty.val() & !self.uart_out.busy.val();
-        self.uart_out.data.next = self.fifo.data.val();
+        self.tx_fifo.write.next = self.reply_tx.fifo_write.val();
+        self.tx_fifo.write_data.next = self.reply_tx.fifo_data.val();
+        self.tx_fifo.read.next = !self.tx_fifo.empty.val() & !self.uart_out.busy.val();
+        self.uart_out.start.next = !self.tx_fifo.empty.val() & !self.uart_out.busy.val();
+        self.uart_out.data.next = self.tx_fifo.data.val();
         self.uart_out.divisor.next = self.divisor.val();
         self.uart_tx.next = self.uart_out.tx.val();
-        // PWM: duty = position − encoder count, saturated to 16 bits.
-        self.error.next = self.core.position.val() - self.encoder.count.val();
-        if self.error.val().get_bit(31) {
-            if self.error.val().get_bits::<17>(15) == self.ones17.val() {
-                self.duty.next = self.error.val().get_bits::<16>(0);
-            } else {
-                self.duty.next = self.duty_min.val();
-            }
-        } else if self.error.val().get_bits::<17>(15) == self.zero17.val() {
-            self.duty.next = self.error.val().get_bits::<16>(0);
-        } else {
-            self.duty.next = self.duty_max.val();
-        }
-        self.pwm_gen.period.next = self.exec.pwm_period.val().get_bits::<16>(0);
-        self.pwm_gen.duty.next = self.duty.val();
-        self.pwm_gen.enable.next = self.exec.pwm_period.val() != self.zero32.val();
-        self.pwm_gen.fault.next = self.core.aborted.val();
+        // The position controller; its duty drives the PWM (off without the amplifier).
+        self.servo.reset.next = self.reset.val();
+        self.servo.enable.next = self.exec.amplifier.val();
+        self.servo.tick.next = self.core.tick.val();
+        self.servo.start.next = self.exec.start.val();
+        // rust-hdl workaround: literal bit indices (crate::servo's REFERENCE_LOW, VELOCITY_LOW,
+        // ACCEL_LOW; checked below).
+        self.servo.ref_position.next = self.core.x.val().get_bits::<48>(64);
+        self.servo.velocity.next = self.core.v.val().get_bits::<56>(48);
+        self.servo.accel.next = self.core.a.val().get_bits::<64>(40);
+        self.servo.count.next = self.encoder.count.val();
+        self.servo.period.next = self.exec.servo_period.val();
+        self.servo.kp.next = self.exec.kp.val();
+        self.servo.ki.next = self.exec.ki.val();
+        self.servo.kd.next = self.exec.kd.val();
+        self.servo.kv.next = self.exec.kv.val();
+        self.servo.ka.next = self.exec.ka.val();
+        self.servo.integral_limit.next = self.exec.integral_limit.val();
+        self.servo.output_limit.next = self.exec.output_limit.val();
+        self.servo.following_limit.next = self.exec.following_limit.val();
+        self.servo.d_filter.next = self.exec.d_filter.val();
+        self.pwm_gen.period.next = self.exec.pwm_period.val();
+        self.pwm_gen.duty.next = self.servo.duty.val();
+        self.pwm_gen.enable.next = self.exec.pwm_period.val() != self.zero16.val();
+        self.pwm_gen.fault.next = !self.exec.amplifier.val();
         self.pwm.next = self.pwm_gen.pwm.val();
         self.dir.next = self.pwm_gen.dir.val();
-        self.ref_position.next = self.core.position.val();
+        self.amplifier.next = self.exec.amplifier.val();
         // LEDs.
-        self.led_idle.next = !self.core.busy.val();
-        self.led_busy.next = self.core.busy.val();
-        self.led_fault.next = self.core.aborted.val()
-            | (self.exec.errors.val() != self.zero8.val())
-            | (self.encoder.errors.val() != self.zero16.val());
+        self.led_idle.next = !self.core.busy.val() & !self.core.stopping.val();
+        self.led_busy.next = self.core.busy.val() | self.core.stopping.val();
+        self.led_fault.next = (self.exec.state.val() == self.error_stop.val())
+            | self.exec.uart_error.val()
+            | self.encoder_error.val();
         self.led_heartbeat.next =
             (self.heartbeat.q.val() & self.beat_mask.val()) != self.zero32.val();
     }
@@ -304,10 +445,6 @@ mod tests {
 
     #[test]
     fn io_top_is_synthesizable() {
-        let mut uut = IoTop::default();
-        uut.connect_all();
-        let v = crate::verilog::direct_clocks(&generate_verilog(&uut));
-        yosys_validate("io_top", &v).unwrap();
-        crate::synth_check::synth_xilinx("io_top", &v);
+        crate::synth_check::synth_block("io_top", IoTop::default());
     }
 }

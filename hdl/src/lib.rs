@@ -29,12 +29,17 @@ pub mod input_filter;
 pub mod io_top;
 pub mod payload_shift;
 pub mod program_memory;
+pub mod protocol_v;
 pub mod pwm;
 pub mod quadrature;
-pub mod reply_packer;
+pub mod reply_queue;
 pub mod reply_tx;
 pub mod sequencer;
+pub mod servo;
 pub mod sign_extend;
+pub mod sim_bits;
+pub mod status_block;
+pub mod stop_unit;
 pub mod tick_divider;
 pub mod uart_rx;
 pub mod uart_tx;
@@ -83,22 +88,33 @@ const _: () = {
 pub(crate) mod synth_check {
     use std::process::Command;
 
-    /// Synthesises `verilog` (top module `top`) for the 7 series; panics on a Yosys error or
-    /// on any latch. Returns the `stat` text.
-    pub fn synth_xilinx(name: &str, verilog: &str) -> String {
+    use rust_hdl::prelude::Block;
+
+    /// Generates `uut`'s Verilog as `snapgen_NAME` (as [`crate::verilog::emit`] finishes every
+    /// design) and synthesises it for the 7 series; panics on a Yosys error or on any latch.
+    /// Returns the `stat` text.
+    pub fn synth_block<U: Block>(name: &str, uut: U) -> String {
+        let top = format!("snapgen_{name}");
+        let mut waivers = crate::verilog::SEQUENCER_HINTS.to_vec();
+        if name == "io_top" {
+            waivers = crate::verilog::io_top_waivers();
+        }
+        let verilog = crate::verilog::block_verilog(uut, &top, &waivers)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
         let dir = std::env::temp_dir().join(format!("snapgen-synth-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("top.v");
+        let file = dir.join(format!("{top}.v"));
         std::fs::write(&file, verilog).unwrap();
         let out = Command::new("yosys")
             .args(["-q", "-p"])
             .arg(format!(
-                "read_verilog {}; synth_xilinx -family xc7 -top top -flatten -noiopad; tee -q -o /dev/stdout stat",
+                "read_verilog {}; hierarchy -check -top {top}; synth_xilinx -family xc7 -top {top} -flatten -noiopad; tee -q -o /dev/stdout stat",
                 file.display()
             ))
             .output()
             .expect("yosys is installed by the test command (scripts/test.sh)");
         let text = String::from_utf8_lossy(&out.stdout).to_string();
+        let _ = std::fs::remove_dir_all(&dir);
         assert!(
             out.status.success(),
             "{name}: yosys failed: {}",

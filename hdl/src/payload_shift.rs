@@ -1,114 +1,86 @@
-//! The last 18 payload bytes of a frame, shifted in one at a time (the newest at the top), with
-//! the command fields read from where each command's payload lands (docs/PROTOCOL.md):
-//! LOAD_SEGMENT (18 bytes): index, ticks, snap; COMMIT (1 or 2 bytes): count and cruise
-//! segment; CONFIGURE (5 bytes): param, value. The field wiring is byte concatenation, which `#[hdl_gen]` cannot express, so
-//! this block writes its Verilog and models it for rust-hdl's simulator.
+//! The last bytes of a frame, shifted in one at a time: its payload (the last
+//! [`PAYLOAD_BYTES`], the newest in bits 7:0, as
+//! `snapgen_model::io::frame_rx::FrameRxOutputs::payload`, so byte `k` of an `n`-byte payload
+//! is bits `8(n-1-k) +: 8`) followed by its two CRC bytes. The longest command payload
+//! (LOAD_SEGMENT) fits; a longer frame is refused by its length anyway. Written as Verilog (a
+//! byte shift is a concatenation, which `#[hdl_gen]` cannot express) and modelled for
+//! rust-hdl's simulator.
 
 use rust_hdl::prelude::*;
+use snapgen_model::protocol::COMMANDS;
 
-use crate::{D_BITS, TICK_BITS};
+use crate::sim_bits::from_u128;
 
-/// Payload bytes kept.
+/// Payload bytes kept: the longest command payload.
 pub const PAYLOAD_BYTES: usize = 18;
+/// Their bits.
+pub const PAYLOAD_BITS: usize = 8 * PAYLOAD_BYTES;
+/// Bytes held: the payload and the CRC.
+const HELD: usize = PAYLOAD_BYTES + 2;
 
-/// Payload shift register and field decoder.
+const _: () = {
+    let mut k = 0;
+    while k < COMMANDS.len() {
+        assert!(COMMANDS[k].len as usize <= PAYLOAD_BYTES);
+        k += 1;
+    }
+};
+
+/// Payload and CRC shift register.
 #[derive(LogicBlock, Default)]
 pub struct PayloadShift {
     /// Fabric clock.
     pub clock: Signal<In, Clock>,
-    /// Shift `data` in.
+    /// Shift `data` in (a payload or CRC byte).
     pub shift: Signal<In, Bit>,
-    /// Payload byte.
+    /// The byte.
     pub data: Signal<In, Bits<8>>,
-    /// LOAD_SEGMENT index.
-    pub seg_index: Signal<Out, Bits<8>>,
-    /// LOAD_SEGMENT ticks.
-    pub seg_ticks: Signal<Out, Bits<TICK_BITS>>,
-    /// LOAD_SEGMENT snap.
-    pub seg_snap: Signal<Out, Bits<D_BITS>>,
-    /// COMMIT count (one-byte COMMIT) or cruise index (two-byte COMMIT): the last byte.
-    pub commit_count: Signal<Out, Bits<8>>,
-    /// COMMIT count of a two-byte COMMIT: the byte before the last.
-    pub commit_first: Signal<Out, Bits<8>>,
-    /// CONFIGURE parameter.
-    pub cfg_param: Signal<Out, Bits<8>>,
-    /// CONFIGURE value.
-    pub cfg_value: Signal<Out, Bits<32>>,
-    _bytes: Vec<u8>,
-}
-
-fn le(bytes: &[u8]) -> u128 {
-    bytes
-        .iter()
-        .rev()
-        .fold(0u128, |acc, &b| (acc << 8) | u128::from(b))
-}
-
-fn bits<const N: usize>(v: u128) -> Bits<N> {
-    let mut b = Bits::<N>::default();
-    for i in 0..N {
-        if (v >> i) & 1 == 1 {
-            b = b.replace_bit(i, true);
-        }
-    }
-    b
+    /// The payload bytes, newest in bits 7:0 (valid once the CRC bytes are in).
+    pub bytes: Signal<Out, Bits<PAYLOAD_BITS>>,
+    /// The CRC the frame carried (its low byte came first).
+    pub crc: Signal<Out, Bits<16>>,
+    _held: [u8; HELD],
 }
 
 impl Logic for PayloadShift {
     fn update(&mut self) {
-        if self._bytes.len() != PAYLOAD_BYTES {
-            self._bytes = vec![0; PAYLOAD_BYTES];
-        }
         if self.clock.pos_edge() && self.shift.val() {
-            self._bytes.remove(0);
-            self._bytes.push(self.data.val().to_u64() as u8);
+            self._held.copy_within(0..HELD - 1, 1);
+            self._held[0] = self.data.val().to_u64() as u8;
         }
-        let p = &self._bytes;
-        self.seg_index.next = bits(u128::from(p[0]));
-        self.seg_ticks.next = bits(le(&p[1..5]));
-        self.seg_snap.next = bits(le(&p[5..18]));
-        self.commit_count.next = bits(u128::from(p[17]));
-        self.commit_first.next = bits(u128::from(p[16]));
-        self.cfg_param.next = bits(u128::from(p[13]));
-        self.cfg_value.next = bits(le(&p[14..18]));
+        // _held[0] is the CRC's high byte, _held[1] its low byte, _held[2..] the payload.
+        let p = &self._held[2..];
+        let low = (0..16).fold(0u128, |v, k| v | (u128::from(p[k]) << (8 * k)));
+        let mut b: Bits<PAYLOAD_BITS> = from_u128(low);
+        for (k, &byte) in p.iter().enumerate().skip(16) {
+            for bit in 0..8 {
+                b = b.replace_bit(8 * k + bit, (byte >> bit) & 1 == 1);
+            }
+        }
+        self.bytes.next = b;
+        self.crc.next = u64::from(u16::from_le_bytes([self._held[1], self._held[0]])).into();
     }
 
     fn connect(&mut self) {
-        self.seg_index.connect();
-        self.seg_ticks.connect();
-        self.seg_snap.connect();
-        self.commit_count.connect();
-        self.commit_first.connect();
-        self.cfg_param.connect();
-        self.cfg_value.connect();
+        self.bytes.connect();
+        self.crc.connect();
     }
 
     fn hdl(&self) -> Verilog {
-        let snap: Vec<String> = (5..18).rev().map(|k| format!("p[{k}]")).collect();
+        let top = 8 * HELD - 1;
         Verilog::Custom(format!(
             "\
-reg [7:0] p [0:17];
-integer k;
-initial begin
-   for (k = 0; k < 18; k = k + 1) p[k] = 8'h00;
-end
+reg [{top}:0] held = {bits}'d0;             // payload, then CRC low, CRC high (in 7:0)
 always @(posedge clock) begin
-   if (shift) begin
-      for (k = 0; k < 17; k = k + 1) p[k] <= p[k + 1];
-      p[17] <= data;
-   end
+   if (shift) held <= {{held[{below}:0], data}};
 end
 always @(*) begin
-   seg_index = p[0];
-   seg_ticks = {{p[4], p[3], p[2], p[1]}};
-   seg_snap = {{{snap}}};
-   commit_count = p[17];
-   commit_first = p[16];
-   cfg_param = p[13];
-   cfg_value = {{p[17], p[16], p[15], p[14]}};
+   bytes = held[{top}:16];
+   crc = {{held[7:0], held[15:8]}};
 end
 ",
-            snap = snap.join(", ")
+            bits = top + 1,
+            below = top - 8,
         ))
     }
 }
@@ -119,10 +91,6 @@ mod tests {
 
     #[test]
     fn payload_shift_is_synthesizable() {
-        let mut uut = PayloadShift::default();
-        uut.connect_all();
-        let v = generate_verilog(&uut);
-        yosys_validate("payload_shift", &v).unwrap();
-        crate::synth_check::synth_xilinx("payload_shift", &v);
+        crate::synth_check::synth_block("payload_shift", PayloadShift::default());
     }
 }

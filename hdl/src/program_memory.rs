@@ -99,11 +99,7 @@ mod tests {
 
     #[test]
     fn program_memory_is_synthesizable() {
-        let mut uut = ProgramMemory::default();
-        uut.connect_all();
-        let v = generate_verilog(&uut);
-        yosys_validate("program_memory", &v).unwrap();
-        let stat = crate::synth_check::synth_xilinx("program_memory", &v);
+        let stat = crate::synth_check::synth_block("program_memory", ProgramMemory::default());
         // Asynchronous read: distributed (LUT) RAM, no block RAM.
         assert!(stat.contains("RAM64M") && !stat.contains("RAMB"), "{stat}");
     }

@@ -34,9 +34,9 @@ pub struct QuadratureDecoder<const N: usize> {
     pub index_count: Signal<Out, Bits<N>>,
     /// An index edge was seen since the last clear.
     pub index_seen: Signal<Out, Bit>,
-    fa: InputFilter,
-    fb: InputFilter,
-    fz: InputFilter,
+    filter_a: InputFilter,
+    filter_b: InputFilter,
+    filter_index: InputFilter,
     prev_a: DFF<Bit>,
     prev_b: DFF<Bit>,
     prev_z: DFF<Bit>,
@@ -63,9 +63,9 @@ impl<const N: usize> Default for QuadratureDecoder<N> {
             errors: Default::default(),
             index_count: Default::default(),
             index_seen: Default::default(),
-            fa: InputFilter::new(false),
-            fb: InputFilter::new(false),
-            fz: InputFilter::new(false),
+            filter_a: InputFilter::new(false),
+            filter_b: InputFilter::new(false),
+            filter_index: InputFilter::new(false),
             prev_a: Default::default(),
             prev_b: Default::default(),
             prev_z: Default::default(),
@@ -84,7 +84,7 @@ impl<const N: usize> Default for QuadratureDecoder<N> {
 impl<const N: usize> Logic for QuadratureDecoder<N> {
     #[hdl_gen]
     fn update(&mut self) {
-        clock!(self, clock, fa, fb, fz);
+        clock!(self, clock, filter_a, filter_b, filter_index);
         dff_setup!(
             self,
             clock,
@@ -96,37 +96,37 @@ impl<const N: usize> Logic for QuadratureDecoder<N> {
             index_count_reg,
             index_seen_reg
         );
-        self.fa.pin.next = self.a.val();
-        self.fb.pin.next = self.b.val();
-        self.fz.pin.next = self.index.val();
-        self.fa.filter.next = self.filter.val();
-        self.fb.filter.next = self.filter.val();
-        self.fz.filter.next = self.filter.val();
-        self.prev_a.d.next = self.fa.level.val();
-        self.prev_b.d.next = self.fb.level.val();
-        self.prev_z.d.next = self.fz.level.val();
+        self.filter_a.pin.next = self.a.val();
+        self.filter_b.pin.next = self.b.val();
+        self.filter_index.pin.next = self.index.val();
+        self.filter_a.filter.next = self.filter.val();
+        self.filter_b.filter.next = self.filter.val();
+        self.filter_index.filter.next = self.filter.val();
+        self.prev_a.d.next = self.filter_a.level.val();
+        self.prev_b.d.next = self.filter_b.level.val();
+        self.prev_z.d.next = self.filter_index.level.val();
         if self.clear.val() {
             self.count_reg.d.next = self.count_zero.val();
             self.errors_reg.d.next = self.errors_zero.val();
             self.index_count_reg.d.next = self.count_zero.val();
             self.index_seen_reg.d.next = false;
         } else {
-            if (self.fa.level.val() == self.prev_b.q.val())
-                & (self.fb.level.val() != self.prev_a.q.val())
+            if (self.filter_a.level.val() == self.prev_b.q.val())
+                & (self.filter_b.level.val() != self.prev_a.q.val())
             {
                 self.count_reg.d.next = self.count_reg.q.val() + self.count_one.val();
             }
-            if (self.fb.level.val() == self.prev_a.q.val())
-                & (self.fa.level.val() != self.prev_b.q.val())
+            if (self.filter_b.level.val() == self.prev_a.q.val())
+                & (self.filter_a.level.val() != self.prev_b.q.val())
             {
                 self.count_reg.d.next = self.count_reg.q.val() - self.count_one.val();
             }
-            if (self.fa.level.val() != self.prev_a.q.val())
-                & (self.fb.level.val() != self.prev_b.q.val())
+            if (self.filter_a.level.val() != self.prev_a.q.val())
+                & (self.filter_b.level.val() != self.prev_b.q.val())
             {
                 self.errors_reg.d.next = self.errors_reg.q.val() + self.errors_one.val();
             }
-            if self.fz.level.val() & !self.prev_z.q.val() {
+            if self.filter_index.level.val() & !self.prev_z.q.val() {
                 self.index_count_reg.d.next = self.count_reg.q.val();
                 self.index_seen_reg.d.next = true;
             }
@@ -144,10 +144,6 @@ mod tests {
 
     #[test]
     fn quadrature_decoder_is_synthesizable() {
-        let mut uut = QuadratureDecoder::<32>::default();
-        uut.connect_all();
-        let v = crate::verilog::direct_clocks(&generate_verilog(&uut));
-        yosys_validate("quadrature", &v).unwrap();
-        crate::synth_check::synth_xilinx("quadrature", &v);
+        crate::synth_check::synth_block("quadrature", QuadratureDecoder::<32>::default());
     }
 }

@@ -5,6 +5,10 @@
 //! may last a single tick. On the last tick of the last segment it drops the snap to 0 and
 //! raises `done`. A start is accepted only while idle; an abort stops it at once. The first
 //! program tick is the first tick strictly after the clock that accepted the start.
+//!
+//! When a controlled stop is taken (`engage`, on a tick) the program is cut there: busy and
+//! done fall and the snap drops to 0 (the stop unit feeds the chain from the next tick). The
+//! tick counter counts every tick while a program plays or a stop runs (`stopping`).
 
 use rust_hdl::prelude::*;
 
@@ -22,11 +26,11 @@ pub struct Sequencer {
     /// Start the program (ignored while busy).
     pub start: Signal<In, Bit>,
     /// Stop now.
-    pub stop: Signal<In, Bit>,
-    /// Controlled stop: end the cruise segment on its next tick (armed until the next start).
-    pub soft_stop: Signal<In, Bit>,
-    /// Index of the cruise segment of the program being read (63: none).
-    pub cruise: Signal<In, Bits<INDEX_BITS>>,
+    pub abort_move: Signal<In, Bit>,
+    /// A controlled stop is taken on this clock's tick: cut the program.
+    pub engage: Signal<In, Bit>,
+    /// A controlled stop runs (its ticks are counted).
+    pub stopping: Signal<In, Bit>,
     /// Segments in the program (of the bank being read).
     pub count: Signal<In, Bits<INDEX_BITS>>,
     /// Memory read data at `address`: tick count.
@@ -53,9 +57,7 @@ pub struct Sequencer {
     left: DFF<Bits<TICK_BITS>>,
     snap_reg: DFF<Bits<D_BITS>>,
     tick_count_reg: DFF<Bits<TICK_BITS>>,
-    skip: DFF<Bit>,
     next_index: Signal<Local, Bits<INDEX_BITS>>,
-    cut: Signal<Local, Bit>,
     // Sized constants (rust-hdl emits bare literals as 32-bit: WIDTH warnings).
     index_zero: Constant<Bits<INDEX_BITS>>,
     index_one: Constant<Bits<INDEX_BITS>>,
@@ -72,9 +74,9 @@ impl Default for Sequencer {
             reset: Default::default(),
             tick: Default::default(),
             start: Default::default(),
-            stop: Default::default(),
-            soft_stop: Default::default(),
-            cruise: Default::default(),
+            abort_move: Default::default(),
+            engage: Default::default(),
+            stopping: Default::default(),
             count: Default::default(),
             entry_ticks: Default::default(),
             entry_snap: Default::default(),
@@ -91,9 +93,7 @@ impl Default for Sequencer {
             left: Default::default(),
             snap_reg: Default::default(),
             tick_count_reg: Default::default(),
-            skip: Default::default(),
             next_index: Default::default(),
-            cut: Default::default(),
             index_zero: Constant::new(0.into()),
             index_one: Constant::new(1.into()),
             address_zero: Constant::new(0.into()),
@@ -115,10 +115,8 @@ impl Logic for Sequencer {
             index_reg,
             left,
             snap_reg,
-            tick_count_reg,
-            skip
+            tick_count_reg
         );
-        self.cut.next = self.skip.q.val() & (self.index_reg.q.val() == self.cruise.val());
         self.next_index.next = self.index_reg.q.val() + self.index_one.val();
         if self.busy_reg.q.val() {
             self.address.next = self.next_index.val().get_bits::<ADDR_BITS>(0);
@@ -133,7 +131,7 @@ impl Logic for Sequencer {
             self.left.d.next = self.ticks_zero.val();
             self.snap_reg.d.next = self.snap_zero.val();
             self.tick_count_reg.d.next = self.ticks_zero.val();
-        } else if self.stop.val() {
+        } else if self.abort_move.val() {
             self.busy_reg.d.next = false;
             self.snap_reg.d.next = self.snap_zero.val();
         } else if self.start.val() & !self.busy_reg.q.val() {
@@ -149,27 +147,29 @@ impl Logic for Sequencer {
                 self.left.d.next = self.entry_ticks.val();
                 self.snap_reg.d.next = self.entry_snap.val();
             }
-        } else if self.tick.val() & self.busy_reg.q.val() {
-            self.tick_count_reg.d.next = self.tick_count_reg.q.val() + self.ticks_one.val();
-            if (self.left.q.val() == self.ticks_one.val()) | self.cut.val() {
-                self.index_reg.d.next = self.next_index.val();
-                if self.next_index.val() == self.count.val() {
-                    self.busy_reg.d.next = false;
-                    self.done_reg.d.next = true;
-                    self.snap_reg.d.next = self.snap_zero.val();
-                } else {
-                    self.left.d.next = self.entry_ticks.val();
-                    self.snap_reg.d.next = self.entry_snap.val();
-                }
-            } else {
-                self.left.d.next = self.left.q.val() - self.ticks_one.val();
+        } else if self.tick.val() {
+            if self.busy_reg.q.val() | self.stopping.val() {
+                self.tick_count_reg.d.next = self.tick_count_reg.q.val() + self.ticks_one.val();
             }
-        }
-        // The controlled stop is armed while playing and cleared by a start or a reset.
-        if self.reset.val() | (self.start.val() & !self.busy_reg.q.val() & !self.stop.val()) {
-            self.skip.d.next = false;
-        } else if self.soft_stop.val() & self.busy_reg.q.val() & !self.stop.val() {
-            self.skip.d.next = true;
+            if self.engage.val() {
+                self.busy_reg.d.next = false;
+                self.done_reg.d.next = false;
+                self.snap_reg.d.next = self.snap_zero.val();
+            } else if self.busy_reg.q.val() {
+                if self.left.q.val() == self.ticks_one.val() {
+                    self.index_reg.d.next = self.next_index.val();
+                    if self.next_index.val() == self.count.val() {
+                        self.busy_reg.d.next = false;
+                        self.done_reg.d.next = true;
+                        self.snap_reg.d.next = self.snap_zero.val();
+                    } else {
+                        self.left.d.next = self.entry_ticks.val();
+                        self.snap_reg.d.next = self.entry_snap.val();
+                    }
+                } else {
+                    self.left.d.next = self.left.q.val() - self.ticks_one.val();
+                }
+            }
         }
         self.snap.next = self.snap_reg.q.val();
         self.busy.next = self.busy_reg.q.val();
@@ -185,10 +185,6 @@ mod tests {
 
     #[test]
     fn sequencer_is_synthesizable() {
-        let mut uut = Sequencer::default();
-        uut.connect_all();
-        let v = generate_verilog(&uut);
-        yosys_validate("sequencer", &v).unwrap();
-        crate::synth_check::synth_xilinx("sequencer", &v);
+        crate::synth_check::synth_block("sequencer", Sequencer::default());
     }
 }

@@ -5,7 +5,9 @@
 
 use rust_hdl::prelude::*;
 
-use crate::{V_BITS, X_BITS};
+use crate::{FRAC, POSITION_BITS, V_BITS, X_BITS};
+
+const _: () = assert!(FRAC + POSITION_BITS == X_BITS);
 
 /// `out = sign_extend(inp)`.
 #[derive(LogicBlock, Default)]
@@ -41,16 +43,49 @@ impl Logic for SignExtend {
     }
 }
 
+/// The centre of an output cell: `{cell, 1'b1, 0…}` — the position register at rest on the
+/// 32-bit output LSB `cell` (what the chain loads when the reference takes the encoder's
+/// position). A tiny hand-written module for the same reasons as [`SignExtend`].
+#[derive(LogicBlock, Default)]
+pub struct CellCentre {
+    /// The cell (output LSBs, 32 bits; `cell` is a Verilog keyword).
+    pub position: Signal<In, Bits<POSITION_BITS>>,
+    /// The position register.
+    pub out: Signal<Out, Bits<X_BITS>>,
+}
+
+impl Logic for CellCentre {
+    fn update(&mut self) {
+        let mut out = Bits::<X_BITS>::default().replace_bit(FRAC - 1, true);
+        for k in 0..POSITION_BITS {
+            out = out.replace_bit(FRAC + k, self.position.val().get_bit(k));
+        }
+        self.out.next = out;
+    }
+
+    fn connect(&mut self) {
+        self.out.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(format!(
+            "always @(*) out = {{position, 1'b1, {}'d0}};\n",
+            FRAC - 1
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn sign_extend_is_synthesizable() {
-        let mut uut = SignExtend::default();
-        uut.connect_all();
-        let v = generate_verilog(&uut);
-        yosys_validate("sign_extend", &v).unwrap();
-        crate::synth_check::synth_xilinx("sign_extend", &v);
+        crate::synth_check::synth_block("sign_extend", SignExtend::default());
+    }
+
+    #[test]
+    fn cell_centre_is_synthesizable() {
+        crate::synth_check::synth_block("cell_centre", CellCentre::default());
     }
 }

@@ -1,24 +1,126 @@
-//! Verilog generation for the motion core.
+//! Verilog generation: rust-hdl's output made into files a hardware engineer can drop into a
+//! project.
 //!
-//! rust-hdl routes every sub-block's clock through the parent's combinational `always @(*)`
-//! block (`chain$clock = clock;` then `.clock(chain$clock)`). That is legal, but it makes the
-//! clock a combinationally derived signal: Verilator re-evaluates all combinational logic on
-//! both clock edges and schedules the flip-flops after it settles, which made co-simulation
-//! several times slower, and it is not how a reader expects a clock to be wired.
-//! [`direct_clocks`] rewrites those connections to use the module's `clock` port directly and
-//! drops the intermediate signals; nothing else in the text changes. (Workaround for rust-hdl
-//! 0.46, which is frozen.)
+//! rust-hdl 0.46 names the top module `top`, every submodule `top$child$grandchild` and every
+//! child port signal `child$port`, and routes each child's clock through the parent's
+//! combinational block. Two generated files therefore cannot be read together (both define
+//! `top` and the same `top$…` modules), and `$` needs escaping in XDC and TCL. [`emit`] turns
+//! that output into one self-contained file per design:
+//!
+//! * every module is named after the design (`snapgen_core`, `snapgen_core_sequencer`, …):
+//!   the top `top` becomes the design's prefix, `top$a$b` becomes `PREFIX_a_b`, and every
+//!   other `$` in a name becomes `_` (the renaming is checked to be one-to-one);
+//! * clocks are wired directly ([`direct_clocks`]);
+//! * `` `default_nettype none`` holds over the design (and `wire` is restored after it);
+//! * the few lint waivers and scheduling hints the design needs are written into the file next
+//!   to the declaration they concern, each with its reason, so `verilator --lint-only -Wall`
+//!   is clean on the files alone, with no configuration file.
+//!
+//! (Workarounds for rust-hdl 0.46, which is frozen; see docs/HDL.md.)
 
 use rust_hdl::prelude::*;
 
 use crate::core::MotionCore;
-use crate::io_top::{IoTop, IoTopConfig};
+use crate::io_top::IoTop;
+use snapgen_model::device::Design;
+
+/// Module prefix of the motion core design (`snapgen_core.v`).
+pub const CORE_PREFIX: &str = "snapgen_core";
+/// Module prefix of the I/O top design (`snapgen_io.v`).
+pub const IO_PREFIX: &str = "snapgen_io";
+
+/// Why generated Verilog could not be finished.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum VerilogError {
+    /// Two different rust-hdl names would get the same Verilog name.
+    #[error("the names {first:?} and {second:?} would both become {name:?}: rename one of the rust-hdl fields")]
+    NameCollision {
+        /// One original name.
+        first: String,
+        /// The other.
+        second: String,
+        /// The name both map to.
+        name: String,
+    },
+    /// A lint waiver names a declaration the design does not have (stale waiver).
+    #[error("waiver {rule} for {signal:?} in module *{module}: no such declaration")]
+    StaleWaiver {
+        /// Rule.
+        rule: &'static str,
+        /// Module path (after the prefix).
+        module: &'static str,
+        /// Signal.
+        signal: &'static str,
+    },
+    /// rust-hdl produced clock routing of a shape [`direct_clocks`] does not know.
+    #[error("rust-hdl clock routing of an unknown shape survived direct_clocks")]
+    ClockRouting,
+}
+
+/// What is written next to one declaration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Note {
+    /// `verilator lint_off RULE` before the declaration and `lint_on` after it.
+    LintOff(&'static str),
+    /// `/* verilator isolate_assignments */` on the declaration: a scheduling hint that makes
+    /// Verilator give the signal's assignments blocks of their own. Optional: a design without
+    /// the signal is fine.
+    IsolateAssignments,
+}
+
+/// A waiver or hint for one declaration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Waiver {
+    /// The module: its path below the design's top (`"core_sequencer"`, `""` for the top);
+    /// any module whose name ends in `_PATH` (or equals it) matches.
+    pub module: &'static str,
+    /// The declared signal (after renaming).
+    pub signal: &'static str,
+    /// What to write.
+    pub note: Note,
+    /// Why, written into the file.
+    pub reason: &'static str,
+}
+
+/// Hints every design with a sequencer uses.
+///
+/// rust-hdl emits one `always @(*)` block per module, so the core's block (reads the
+/// sequencer's memory address, drives its count and memory-data inputs) and the sequencer's
+/// block (reads those, drives the address) form a loop at block granularity only: the address
+/// depends on registers alone. Isolating the address (and the next index it comes from) breaks
+/// the false loop, so Verilator orders the logic statically instead of re-evaluating it until
+/// it settles (co-simulation 41 → 35 ns a clock), and no UNOPTFLAT waiver is needed.
+pub const SEQUENCER_HINTS: [Waiver; 2] = [
+    Waiver {
+        module: "sequencer",
+        signal: "address",
+        note: Note::IsolateAssignments,
+        reason: "depends on registers only: breaks a false block-level loop with the core",
+    },
+    Waiver {
+        module: "sequencer",
+        signal: "next_index",
+        note: Note::IsolateAssignments,
+        reason: "the address is computed from it",
+    },
+];
+
+/// Every waiver and hint of the I/O top design.
+pub fn io_top_waivers() -> Vec<Waiver> {
+    let mut w = SEQUENCER_HINTS.to_vec();
+    w.extend_from_slice(&crate::io_top::WAIVERS);
+    w
+}
 
 /// Rewrites `NAME$clock` clock routing into direct `.clock(clock)` connections.
 ///
-/// Panics if a `$clock` signal is left over: that would mean rust-hdl's output has a shape
-/// this rewrite does not know, and the result must not be used.
-pub fn direct_clocks(verilog: &str) -> String {
+/// rust-hdl routes every sub-block's clock through the parent's combinational `always @(*)`
+/// block (`chain$clock = clock;` then `.clock(chain$clock)`). That is legal, but it makes the
+/// clock a combinationally derived signal: Verilator re-evaluates all combinational logic on
+/// both clock edges and schedules the flip-flops after it settles, which made co-simulation
+/// several times slower, and it is not how a reader expects a clock to be wired. This drops the
+/// intermediate signals; nothing else in the text changes.
+pub fn direct_clocks(verilog: &str) -> Result<String, VerilogError> {
     let is_name = |s: &str| {
         !s.is_empty()
             && s.chars()
@@ -55,44 +157,287 @@ pub fn direct_clocks(verilog: &str) -> String {
         out.push_str(line);
         out.push('\n');
     }
-    assert!(
-        !out.contains("$clock"),
-        "rust-hdl clock routing of an unknown shape survived direct_clocks"
-    );
-    out
+    if out.contains("$clock") {
+        return Err(VerilogError::ClockRouting);
+    }
+    Ok(out)
 }
 
-/// The motion core's Verilog: one file, top module `top`, submodules `top$<name>`.
+/// The Verilog name of a rust-hdl name in a design with module prefix `prefix`.
+fn verilog_name(name: &str, prefix: &str) -> String {
+    if name == "top" {
+        prefix.to_string()
+    } else if let Some(rest) = name.strip_prefix("top$") {
+        format!("{prefix}_{}", rest.replace('$', "_"))
+    } else {
+        name.replace('$', "_")
+    }
+}
+
+/// Renames every identifier (see the module documentation); fails if two names of one scope
+/// would merge: module names across the file, signal names within their module.
+fn rename(verilog: &str, prefix: &str) -> Result<String, VerilogError> {
+    use std::collections::HashMap;
+    // New name → the original it came from, to prove the renaming one-to-one.
+    let mut modules: HashMap<String, String> = HashMap::new();
+    let mut signals: HashMap<String, String> = HashMap::new();
+    let check = |map: &mut HashMap<String, String>, new: &str, name: &str| match map.get(new) {
+        Some(first) if first != name => Err(VerilogError::NameCollision {
+            first: first.clone(),
+            second: name.to_string(),
+            name: new.to_string(),
+        }),
+        Some(_) => Ok(()),
+        None => {
+            map.insert(new.to_string(), name.to_string());
+            Ok(())
+        }
+    };
+    let mut out = String::with_capacity(verilog.len());
+    let bytes = verilog.as_bytes();
+    let mut i = 0;
+    let start_char = |b: u8| b.is_ascii_alphabetic() || b == b'_';
+    let name_char = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'$';
+    while i < bytes.len() {
+        let b = bytes[i];
+        // A system task (`$signed`) or a sized literal's base (`32'h50`) is not a name.
+        let after_quote_or_dollar = i > 0 && matches!(bytes[i - 1], b'\'' | b'$');
+        if start_char(b) && after_quote_or_dollar {
+            let begin = i;
+            while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                i += 1;
+            }
+            out.push_str(&verilog[begin..i]);
+        } else if start_char(b) {
+            let begin = i;
+            while i < bytes.len() && name_char(bytes[i]) {
+                i += 1;
+            }
+            let name = &verilog[begin..i];
+            if name == "module" {
+                // A new module: a new scope for signal names.
+                signals.clear();
+            }
+            let new = verilog_name(name, prefix);
+            // `.port(` names a port of the instantiated module: checked in that module.
+            let port_of_child = out.trim_end().ends_with('.');
+            if name == "top" || name.starts_with("top$") {
+                check(&mut modules, &new, name)?;
+            } else if !port_of_child {
+                check(&mut signals, &new, name)?;
+            }
+            out.push_str(&new);
+        } else {
+            // Copy one whole character (comments may hold non-ASCII text).
+            let ch = verilog[i..].chars().next().expect("in bounds");
+            out.push(ch);
+            i += ch.len_utf8();
+        }
+    }
+    Ok(out)
+}
+
+/// The module a `module NAME(` line declares.
+fn module_name(line: &str) -> Option<&str> {
+    let rest = line.trim_start().strip_prefix("module ")?;
+    let end = rest.find(['(', ' ', ';'])?;
+    Some(&rest[..end])
+}
+
+/// The signal a declaration line (`wire [3:0] name;`, `output reg x;`, …) declares.
+fn declared(line: &str) -> Option<&str> {
+    let t = line.trim();
+    let first = t.split_whitespace().next()?;
+    if !matches!(first, "wire" | "reg" | "input" | "output" | "localparam") {
+        return None;
+    }
+    let body = t.strip_suffix(';')?;
+    body.rsplit([' ', ']']).next()
+}
+
+fn module_matches(module: &str, path: &str, prefix: &str) -> bool {
+    if path.is_empty() {
+        module == prefix
+    } else {
+        module == path || module.ends_with(&format!("_{path}"))
+    }
+}
+
+/// Modules synthesis keeps as blocks of their own (`(* keep_hierarchy = "yes" *)`, honoured by
+/// Yosys and Vivado), by the path below the design's top, with the reason.
+pub const KEPT_MODULES: [(&str, &str); 1] = [(
+    "stop_unit",
+    "its word-serial engine reads the chain registers through one operand mux: flattened \
+     into the core, Yosys merged that mux with the chain's logic (1 700 -> 2 200 LUTs)",
+)];
+
+/// Writes each waiver and hint next to its declaration, and the kept modules' attribute.
+fn annotate(verilog: &str, prefix: &str, waivers: &[Waiver]) -> Result<String, VerilogError> {
+    let mut used = vec![false; waivers.len()];
+    let mut out = String::with_capacity(verilog.len() + 64 * waivers.len());
+    let mut module = "";
+    for line in verilog.lines() {
+        if let Some(m) = module_name(line) {
+            module = m;
+            if let Some((_, why)) = KEPT_MODULES
+                .iter()
+                .find(|(path, _)| module_matches(m, path, prefix))
+            {
+                out.push_str(&format!("// Kept as a block in synthesis: {why}.\n"));
+                out.push_str("(* keep_hierarchy = \"yes\" *)\n");
+            }
+        }
+        let hits: Vec<usize> = match declared(line) {
+            Some(sig) => waivers
+                .iter()
+                .enumerate()
+                .filter(|(_, w)| w.signal == sig && module_matches(module, w.module, prefix))
+                .map(|(k, _)| k)
+                .collect(),
+            None => Vec::new(),
+        };
+        if hits.is_empty() {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        let indent = &line[..line.len() - line.trim_start().len()];
+        let mut decl = line.to_string();
+        let mut after = Vec::new();
+        for &k in &hits {
+            used[k] = true;
+            let w = &waivers[k];
+            match w.note {
+                Note::LintOff(rule) => {
+                    out.push_str(&format!(
+                        "{indent}/* verilator lint_off {rule} */ // {}\n",
+                        w.reason
+                    ));
+                    after.push(format!("{indent}/* verilator lint_on {rule} */\n"));
+                }
+                Note::IsolateAssignments => {
+                    let semi = decl.rfind(';').expect("a declaration ends in ';'");
+                    decl.insert_str(semi, " /* verilator isolate_assignments */");
+                    decl.push_str(&format!(" // {}", w.reason));
+                }
+            }
+        }
+        out.push_str(&decl);
+        out.push('\n');
+        for a in after {
+            out.push_str(&a);
+        }
+    }
+    for (w, used) in waivers.iter().zip(used) {
+        if let (Note::LintOff(rule), false) = (w.note, used) {
+            return Err(VerilogError::StaleWaiver {
+                rule,
+                module: w.module,
+                signal: w.signal,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Finishes rust-hdl's Verilog for a design: direct clocks, names under `prefix`, the waivers
+/// and hints, `` `default_nettype none`` and a header (`header`: comment lines, without `//`).
+pub fn emit(
+    raw: &str,
+    prefix: &str,
+    header: &[String],
+    waivers: &[Waiver],
+) -> Result<String, VerilogError> {
+    let body = annotate(&rename(&direct_clocks(raw)?, prefix)?, prefix, waivers)?;
+    let mut out = String::new();
+    for h in header {
+        out.push_str(&format!("// {h}\n"));
+    }
+    out.push_str(&format!(
+        "// Generated by snapgen {} from rust-hdl 0.46. Do not edit: regenerate it.\n\
+         // Modules: {prefix} and its submodules {prefix}_*.\n\n\
+         /* verilator lint_off DECLFILENAME */ // the file holds the design's submodules too\n\
+         `default_nettype none\n",
+        env!("CARGO_PKG_VERSION"),
+    ));
+    out.push_str(body.trim_start_matches('\n'));
+    out.push_str("`default_nettype wire\n/* verilator lint_on DECLFILENAME */\n");
+    Ok(out)
+}
+
+/// Any block's Verilog under `prefix` (its own tests: lint and synthesis).
+pub fn block_verilog<U: Block>(
+    mut uut: U,
+    prefix: &str,
+    waivers: &[Waiver],
+) -> Result<String, VerilogError> {
+    uut.connect_all();
+    emit(&generate_verilog(&uut), prefix, &[], waivers)
+}
+
+/// The motion core's Verilog: `snapgen_core.v`, top module `snapgen_core`.
 pub fn motion_core_verilog() -> String {
     let mut uut = MotionCore::default();
     uut.connect_all();
-    let header = format!(
-        "// snapgen motion core, generated by snapgen {} from rust-hdl 0.46.\n\
-         // Widths: x {}, v/a/j/snap {}, ticks {} bits; {} segments per bank, 2 banks.\n\
-         // Do not edit: regenerate with `snapgen verilog`.\n",
-        env!("CARGO_PKG_VERSION"),
-        crate::X_BITS,
-        crate::V_BITS,
-        crate::TICK_BITS,
-        1 << crate::ADDR_BITS
-    );
-    header + &direct_clocks(&generate_verilog(&uut))
+    let header = [
+        "snapgen motion core: tick divider, two-bank program memory, sequencer, stop unit, snap chain."
+            .to_string(),
+        format!(
+            "Widths: x {}, v/a/j/snap {}, ticks {} bits; {} segments per bank, 2 banks.",
+            crate::X_BITS,
+            crate::V_BITS,
+            crate::TICK_BITS,
+            1 << crate::ADDR_BITS
+        ),
+    ];
+    emit(
+        &generate_verilog(&uut),
+        CORE_PREFIX,
+        &header,
+        &SEQUENCER_HINTS,
+    )
+    .expect("the motion core's names and waivers are checked by its tests")
 }
 
-/// The I/O top's Verilog (top module `top`, to be written as `io_top.v`).
-pub fn io_top_verilog(cfg: IoTopConfig) -> String {
-    let mut uut = IoTop::new(cfg);
+/// The I/O top's Verilog for `design`: `snapgen_io.v`, top module `snapgen_io`. Its identity
+/// (what PING answers) carries `design.design_hash`; [`io_design`] gives a design its hash.
+pub fn io_top_verilog(design: &Design) -> String {
+    let mut uut = IoTop::new(*design);
     uut.connect_all();
-    let header = format!(
-        "// snapgen I/O top (UART command interface, motion core, encoder, PWM), generated by\n\
-         // snapgen {} from rust-hdl 0.46: UART {} clocks per bit, frame timeout {} clocks,\n\
-         // tick divider {} after reset. Do not edit: regenerate with `snapgen verilog`.\n",
-        env!("CARGO_PKG_VERSION"),
-        cfg.uart_divisor,
-        cfg.frame_timeout,
-        cfg.tick_div
-    );
-    header + &direct_clocks(&generate_verilog(&uut))
+    let d = design.dividers;
+    let header = [
+        "snapgen I/O top: UART command interface, motion core, encoder decoder, PWM, limit switches,"
+            .to_string(),
+        "emergency stop, amplifier enable.".to_string(),
+        format!(
+            "Built for: {} Hz clock, {} baud ({} clocks per bit), tick divider {} after reset, frame timeout {} clocks.",
+            design.clock_hz, design.baud, d.uart_divisor, d.tick_div, d.frame_timeout
+        ),
+        format!(
+            "Design hash {:#010x}: FNV-1a (32 bits) of this file generated with the hash 0.",
+            design.design_hash
+        ),
+    ];
+    emit(
+        &generate_verilog(&uut),
+        IO_PREFIX,
+        &header,
+        &io_top_waivers(),
+    )
+    .expect("the I/O top's names and waivers are checked by its tests")
+}
+
+/// `design` with its hash: FNV-1a (32 bits) of its I/O top's Verilog generated with the hash
+/// 0, so a host can tell which design a board runs (docs/HDL.md).
+pub fn io_design(design: &Design) -> Design {
+    let unhashed = Design {
+        design_hash: 0,
+        ..*design
+    };
+    Design {
+        design_hash: snapgen_model::device::fnv1a32(io_top_verilog(&unhashed).as_bytes()),
+        ..*design
+    }
 }
 
 #[cfg(test)]
@@ -100,10 +445,59 @@ mod tests {
     use super::*;
 
     #[test]
-    fn clocks_are_wired_directly() {
+    fn names_have_the_prefix_and_no_dollar() {
         let v = motion_core_verilog();
-        assert!(!v.contains("$clock"));
+        let no_tasks = v.replace("$signed", "").replace("$unsigned", "");
+        assert!(!no_tasks.contains('$'), "a name with '$' survived");
+        assert!(v.contains("module snapgen_core("));
+        assert!(v.contains("module snapgen_core_sequencer("));
+        assert!(!v.contains("module top"));
         assert!(v.contains(".clock(clock)"));
-        yosys_validate("motion_core_direct_clocks", &v).unwrap();
+        assert!(v.contains("`default_nettype none"));
+        assert!(v.contains("isolate_assignments"));
+    }
+
+    #[test]
+    fn renaming_is_checked_one_to_one() {
+        let v = "module top(a$b, a_b);\nendmodule\nmodule top$c(a_b);\nendmodule\n";
+        assert!(matches!(
+            rename(v, "p"),
+            Err(VerilogError::NameCollision { .. })
+        ));
+        // The same name in two modules is two names.
+        assert!(rename(
+            "module top(a$b);\nendmodule\nmodule top$c(a_b);\nendmodule\n",
+            "p"
+        )
+        .is_ok());
+        // Two modules that would merge.
+        assert!(rename(
+            "module top$a$b();\nendmodule\nmodule top$a_b();\nendmodule\n",
+            "p"
+        )
+        .is_err());
+        assert_eq!(
+            rename("module top$x$y(q$d); $signed(q$d) 32'h50\n", "p").unwrap(),
+            "module p_x_y(q_d); $signed(q_d) 32'h50\n"
+        );
+    }
+
+    #[test]
+    fn a_stale_waiver_is_an_error() {
+        let w = Waiver {
+            module: "",
+            signal: "missing",
+            note: Note::LintOff("UNUSEDSIGNAL"),
+            reason: "test",
+        };
+        let v = "module top(a);\n    input wire a;\nendmodule\n";
+        assert_eq!(
+            annotate(v, "top", &[w]),
+            Err(VerilogError::StaleWaiver {
+                rule: "UNUSEDSIGNAL",
+                module: "",
+                signal: "missing"
+            })
+        );
     }
 }

@@ -85,7 +85,13 @@ fn stimulus() -> Vec<(CoreInputs, usize)> {
         ));
         if n == 1 {
             s.push((base, 9));
-            s.push((CoreInputs { stop: true, ..base }, 1));
+            s.push((
+                CoreInputs {
+                    abort: true,
+                    ..base
+                },
+                1,
+            ));
         }
         s.push((base, 14));
     }
@@ -105,7 +111,7 @@ fn rust_hdl_core_matches_the_model_clock_by_clock() {
             x.reset.next = i.reset;
             x.tick_div.next = u64::from(i.tick_div).into();
             x.start.next = i.start;
-            x.stop.next = i.stop;
+            x.abort_move.next = i.abort;
             x.write_enable.next = i.write_enable;
             x.write_address.next = u64::from(i.write_address).into();
             x.write_ticks.next = u64::from(i.write_ticks).into();

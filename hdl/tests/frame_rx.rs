@@ -5,7 +5,7 @@
 
 use rust_hdl::prelude::*;
 use snapgen_hdl::frame_rx::FrameRx;
-use snapgen_model::protocol::{Command, Decoded, Decoder, Frame, Param};
+use snapgen_model::protocol::{Command, Decoded, Decoder, Param};
 use snapgen_model::{Segment, DEFAULT_FORMAT};
 
 mod common;
@@ -18,27 +18,11 @@ enum Event {
     Frame {
         cmd: u8,
         seq: u8,
-        len: u8,
-        fields: Vec<u128>,
+        payload: Vec<u8>,
+        crc: u16,
     },
     BadCrc,
     Dropped,
-}
-
-fn le(b: &[u8]) -> u128 {
-    b.iter().rev().fold(0, |a, &x| (a << 8) | u128::from(x))
-}
-
-/// The fields the receiver exposes for a frame of this length.
-fn fields(f: &Frame) -> Vec<u128> {
-    let p = &f.payload;
-    match p.len() {
-        18 => vec![u128::from(p[0]), le(&p[1..5]), le(&p[5..18])],
-        5 => vec![u128::from(p[0]), le(&p[1..5])],
-        1 => vec![u128::from(p[0])],
-        2 => vec![u128::from(p[0]), u128::from(p[1])],
-        _ => vec![],
-    }
 }
 
 /// (byte, idle clocks after it), and the events the model expects.
@@ -60,11 +44,10 @@ fn stimulus(seed: u64) -> (Vec<(u8, u64)>, Vec<Event>) {
             },
             2 => Command::Commit {
                 count: r.below(40) as u8,
-                cruise: (r.below(2) == 0).then(|| r.below(40) as u8),
             },
             3 => Command::Configure {
-                param: Param::TelemetryPeriod,
-                value: r.next() as u32,
+                param: Param::StopAccel,
+                value: i128::from(r.next()) << 30,
             },
             4 => Command::Start,
             _ => Command::ReadStatus,
@@ -98,12 +81,16 @@ fn stimulus(seed: u64) -> (Vec<(u8, u64)>, Vec<Event>) {
     let mut events = Vec::new();
     for &(b, gap) in &bytes {
         match d.push(b) {
-            Some(Decoded::Frame(fr)) => events.push(Event::Frame {
-                cmd: fr.cmd,
-                seq: fr.seq,
-                len: fr.payload.len() as u8,
-                fields: fields(&fr),
-            }),
+            Some(Decoded::Frame(fr)) => {
+                let wire = fr.to_bytes();
+                let crc = u16::from_le_bytes([wire[wire.len() - 2], wire[wire.len() - 1]]);
+                events.push(Event::Frame {
+                    cmd: fr.cmd,
+                    seq: fr.seq,
+                    payload: fr.payload,
+                    crc,
+                })
+            }
             Some(Decoded::BadCrc) => events.push(Event::BadCrc),
             None => {}
         }
@@ -135,29 +122,16 @@ fn frame_receiver_matches_the_device_decoder() {
         let mut got = Vec::new();
         let mut collect = |x: &FrameRx| {
             if x.frame.val() {
-                let len = x.len.val().to_u64() as u8;
-                let fields = match len {
-                    18 => vec![
-                        x.seg_index.val().to_u64().into(),
-                        x.seg_ticks.val().to_u64().into(),
-                        x.seg_snap.val().to_u128(),
-                    ],
-                    5 => vec![
-                        x.cfg_param.val().to_u64().into(),
-                        x.cfg_value.val().to_u64().into(),
-                    ],
-                    1 => vec![x.commit_count.val().to_u64().into()],
-                    2 => vec![
-                        x.commit_first.val().to_u64().into(),
-                        x.commit_count.val().to_u64().into(),
-                    ],
-                    _ => vec![],
-                };
+                // Byte k of an n-byte payload is bits 8(n-1-k) +: 8.
+                let n = x.len.val().to_u64() as usize;
+                let payload = (0..n)
+                    .map(|k| x.payload.val().get_bits::<8>(8 * (n - 1 - k)).to_u64() as u8)
+                    .collect();
                 got.push(Event::Frame {
                     cmd: x.cmd.val().to_u64() as u8,
                     seq: x.seq.val().to_u64() as u8,
-                    len,
-                    fields,
+                    payload,
+                    crc: x.crc.val().to_u64() as u16,
                 });
             }
             if x.bad_crc.val() {
