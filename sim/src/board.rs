@@ -1,180 +1,163 @@
-//! The virtual board on the fabric: the Verilated I/O top (UART command interface, motion core,
-//! encoder decoder, PWM) driven clock by clock. Host bytes become a UART line waveform (the
-//! model's transmitter); the core's UART output is decoded by the model's receiver; the
-//! encoder pins follow the reference position as an ideal motor would, one count per output
-//! LSB (at most one quadrature step per clock).
+//! A virtual board: the Verilated I/O top ([`crate::io::FabricIo`]) or the device model
+//! (`snapgen_model::device::Device`), clock by clock, with the world around it
+//! (`snapgen_model::peer::Peer`): host bytes become a UART line waveform at the design's baud
+//! rate, the board's UART output is decoded back into bytes, the encoder follows the reference
+//! position as an ideal motor would — or a simulated motor (`snapgen_plant::Plant`) turns under
+//! the board's PWM and drives the encoder ([`VirtualBoard::with_motor`]) — and the limit and
+//! emergency-stop inputs hold their level.
 
-use std::ffi::c_void;
-use std::path::Path;
+use snapgen_model::device::{Design, Device, IoOutputs};
+use snapgen_model::peer::Peer;
+use snapgen_plant::plant::StepError;
+use snapgen_plant::{BridgePins, Physical, Plant};
 
-use libloading::Library;
-use snapgen_model::io::uart::{UartRx, UartTx};
-
+use crate::build::build_io;
+use crate::io::{decode_outputs, encode_inputs, FabricIo, IN_WORDS, OUT_WORDS};
 use crate::SimError;
 
-type NewFn = unsafe extern "C" fn() -> *mut c_void;
-type FreeFn = unsafe extern "C" fn(*mut c_void);
-type RunFn = unsafe extern "C" fn(*mut c_void, u64, *const u8, *mut u8, *mut i32);
-type AbiFn = unsafe extern "C" fn() -> u32;
+/// Clocks the fabric runs per call: the peer computes their pins ahead (the encoder follows
+/// the position of the chunk before, at most this many clocks late).
+const CHUNK: u64 = 256;
 
-/// Settings the I/O top was generated with (`snapgen_hdl::io_top::IoTopConfig`).
-#[derive(Clone, Copy, Debug)]
-pub struct FabricBoardConfig {
-    /// Clocks per UART bit.
-    pub uart_divisor: u16,
+/// What runs the board.
+enum Backend {
+    /// The device model.
+    Model(Box<Device>),
+    /// The Verilated I/O top.
+    Fabric(FabricIo),
 }
 
-/// The Verilated I/O top with its UART and encoder peers.
-pub struct FabricBoard {
-    handle: *mut c_void,
-    free: FreeFn,
-    run: RunFn,
-    cfg: FabricBoardConfig,
-    host_tx: UartTx,
-    host_rx: UartRx,
-    queue: std::collections::VecDeque<u8>,
-    sending: bool,
-    received: Vec<u8>,
-    encoder: i64,
-    target: i64,
-    reset_clocks: u64,
-    ins: Vec<u8>,
-    outs: Vec<u8>,
-    pos: Vec<i32>,
-    _lib: Library,
+/// A virtual board.
+pub struct VirtualBoard {
+    design: Design,
+    peer: Peer,
+    backend: Backend,
+    clocks: u64,
+    ins: Vec<[u32; IN_WORDS]>,
+    outs: Vec<u32>,
+    motor: Option<Plant>,
 }
 
-// Used from one thread at a time.
-unsafe impl Send for FabricBoard {}
+impl VirtualBoard {
+    /// The device model of `design`.
+    pub fn model(design: &Design) -> Self {
+        Self::with(design, Backend::Model(Box::new(Device::new(design))))
+    }
 
-impl FabricBoard {
-    /// Loads the board library and resets the core.
-    pub fn open(library: &Path, cfg: FabricBoardConfig) -> Result<Self, SimError> {
-        let err = |reason: String| SimError::Load {
-            path: library.to_path_buf(),
-            reason,
-        };
-        // SAFETY: the library was built from our own io_harness.cpp (ABI checked).
-        unsafe {
-            let lib = Library::new(library).map_err(|e| err(e.to_string()))?;
-            let abi: AbiFn = *lib
-                .get::<AbiFn>(b"snapgen_io_abi\0")
-                .map_err(|e| err(e.to_string()))?;
-            if abi() != 0x10001 {
-                return Err(err(format!("harness ABI {:#x}", abi())));
-            }
-            let new: NewFn = *lib
-                .get(b"snapgen_io_new\0")
-                .map_err(|e| err(e.to_string()))?;
-            let free: FreeFn = *lib
-                .get(b"snapgen_io_free\0")
-                .map_err(|e| err(e.to_string()))?;
-            let run: RunFn = *lib
-                .get(b"snapgen_io_run\0")
-                .map_err(|e| err(e.to_string()))?;
-            let handle = new();
-            Ok(FabricBoard {
-                handle,
-                free,
-                run,
-                cfg,
-                host_tx: UartTx::new(),
-                host_rx: UartRx::new(),
-                queue: Default::default(),
-                sending: false,
-                received: Vec::new(),
-                encoder: 0,
-                target: 0,
-                reset_clocks: 4,
-                ins: Vec::new(),
-                outs: Vec::new(),
-                pos: Vec::new(),
-                _lib: lib,
-            })
+    /// The Verilated I/O top of `design` (built, or found in the build cache).
+    pub fn fabric(design: &Design) -> Result<Self, SimError> {
+        let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+        let built = build_io(&verilog, false)?;
+        Ok(Self::with(
+            design,
+            Backend::Fabric(FabricIo::open(&built.library, None)?),
+        ))
+    }
+
+    fn with(design: &Design, backend: Backend) -> Self {
+        let mut peer = Peer::new(design.dividers.uart_divisor);
+        // The switches wired as the design expects them.
+        peer.wiring = design.input_polarity;
+        VirtualBoard {
+            design: *design,
+            peer,
+            backend,
+            clocks: 0,
+            ins: Vec::new(),
+            outs: Vec::new(),
+            motor: None,
         }
+    }
+
+    /// A simulated motor on the board's PWM, direction and amplifier pins, its encoder on the
+    /// board's encoder pins (instead of the ideal follower), stepped every `step_s`.
+    pub fn with_motor(mut self, p: &Physical, step_s: f64) -> Result<Self, StepError> {
+        self.motor = Some(Plant::new(p, f64::from(self.design.clock_hz), step_s)?);
+        self.peer.index_period = if p.index { p.counts_per_rev } else { 0 };
+        self.peer.drive_encoder(0);
+        Ok(self)
+    }
+
+    /// The motor, if there is one.
+    pub fn motor(&self) -> Option<&Plant> {
+        self.motor.as_ref()
+    }
+
+    /// The design it runs.
+    pub fn design(&self) -> &Design {
+        &self.design
+    }
+
+    /// Clocks run since power-up.
+    pub fn clocks(&self) -> u64 {
+        self.clocks
+    }
+
+    /// The world around the board: switches, encoder (public fields of [`Peer`]).
+    pub fn peer(&mut self) -> &mut Peer {
+        &mut self.peer
     }
 
     /// Bytes from the host, sent on the UART line in order.
     pub fn receive(&mut self, bytes: &[u8]) {
-        self.queue.extend(bytes);
+        self.peer.send(bytes);
     }
 
-    /// Bytes the core sent.
+    /// Bytes the board sent.
     pub fn take_output(&mut self) -> Vec<u8> {
-        std::mem::take(&mut self.received)
+        self.peer.take_received()
     }
 
-    /// Quadrature levels (A, B) of an encoder count: Gray order 00 → 01 → 11 → 10.
-    fn levels(count: i64) -> (bool, bool) {
-        match count.rem_euclid(4) {
-            0 => (false, false),
-            1 => (false, true),
-            2 => (true, true),
-            _ => (true, false),
+    /// The world's side of a clock's outputs: the host's receiver, and the motor.
+    fn observe(peer: &mut Peer, motor: &mut Option<Plant>, o: &IoOutputs) {
+        peer.observe(o);
+        if let Some(m) = motor {
+            m.clock(BridgePins {
+                pwm: o.pwm,
+                dir: o.dir,
+                enable: o.amplifier,
+            });
         }
     }
 
     /// Runs `clocks` fabric clocks.
     pub fn run(&mut self, clocks: u64) {
-        const CHUNK: u64 = 4096;
-        let mut left = clocks;
-        while left > 0 {
-            let n = left.min(CHUNK) as usize;
-            self.ins.clear();
-            // The host's UART line and the encoder pins are computed a chunk ahead from the
-            // state at the chunk's start; the encoder target is the last reference seen.
-            for _ in 0..n {
-                let next = self.queue.front().copied();
-                let o = self.host_tx.clock(
-                    next.is_some() && !self.sending,
-                    next.unwrap_or(0),
-                    self.cfg.uart_divisor,
-                );
-                if !self.sending && next.is_some() && o.busy {
-                    self.queue.pop_front();
-                }
-                self.sending = o.busy;
-                if self.encoder < self.target {
-                    self.encoder += 1;
-                } else if self.encoder > self.target {
-                    self.encoder -= 1;
-                }
-                let (a, b) = Self::levels(self.encoder);
-                let reset = self.reset_clocks > 0;
-                self.reset_clocks = self.reset_clocks.saturating_sub(1);
-                self.ins.push(
-                    u8::from(reset) | u8::from(o.tx) << 1 | u8::from(a) << 2 | u8::from(b) << 3,
-                );
-            }
-            self.outs.resize(n, 0);
-            self.pos.resize(n, 0);
-            // SAFETY: the buffers hold n entries each; the handle is live.
-            unsafe {
-                (self.run)(
-                    self.handle,
-                    n as u64,
-                    self.ins.as_ptr(),
-                    self.outs.as_mut_ptr(),
-                    self.pos.as_mut_ptr(),
-                )
-            };
-            for k in 0..n {
-                let r = self
-                    .host_rx
-                    .clock(self.outs[k] & 1 == 1, self.cfg.uart_divisor);
-                if r.valid {
-                    self.received.push(r.data);
+        // With a motor, the encoder's pins change only when it steps: one step per batch.
+        let chunk = self
+            .motor
+            .as_ref()
+            .map_or(CHUNK, |m| u64::from(m.step_clocks()));
+        match &mut self.backend {
+            Backend::Model(dev) => {
+                for _ in 0..clocks {
+                    let i = self.peer.inputs();
+                    let o = dev.clock(&i);
+                    Self::observe(&mut self.peer, &mut self.motor, &o);
+                    if let Some(m) = &self.motor {
+                        self.peer.drive_encoder(m.count());
+                    }
                 }
             }
-            self.target = i64::from(self.pos[n - 1]);
-            left -= n as u64;
+            Backend::Fabric(fab) => {
+                let mut left = clocks;
+                while left > 0 {
+                    let n = left.min(chunk) as usize;
+                    self.ins.clear();
+                    for _ in 0..n {
+                        self.ins.push(encode_inputs(&self.peer.inputs()));
+                    }
+                    fab.run(&self.ins, &mut self.outs);
+                    for k in 0..n {
+                        let o = decode_outputs(&self.outs[k * OUT_WORDS..(k + 1) * OUT_WORDS]);
+                        Self::observe(&mut self.peer, &mut self.motor, &o);
+                    }
+                    if let Some(m) = &self.motor {
+                        self.peer.drive_encoder(m.count());
+                    }
+                    left -= n as u64;
+                }
+            }
         }
-    }
-}
-
-impl Drop for FabricBoard {
-    fn drop(&mut self) {
-        // SAFETY: the handle came from snapgen_io_new and is freed once.
-        unsafe { (self.free)(self.handle) }
+        self.clocks += clocks;
     }
 }

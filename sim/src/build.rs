@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! verilator --cc --exe --build -O3 -Wall --x-assign fast --x-initial fast --noassert
-//!           --top-module top verilator.vlt top.v harness.cpp
+//!           --top-module top top.v harness.cpp
 //!           -CFLAGS "-fPIC -march=native -fno-semantic-interposition -DSNAPGEN_TRACE=0|1"
 //!           -MAKEFLAGS "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3"
 //!           -LDFLAGS "-shared -Wl,-Bsymbolic" -o libsnapgen_core.so
@@ -17,10 +17,11 @@
 //! another machine never hands it a library its CPU cannot run.
 //!
 //! Builds are cached in `$SNAPGEN_CACHE_DIR` (default `$XDG_CACHE_HOME/snapgen` or
-//! `~/.cache/snapgen`) under a hash of the Verilog, the waivers, the harness, the Verilator
+//! `~/.cache/snapgen`) under a hash of the Verilog (its lint waivers and scheduling hints are
+//! written into it, see `snapgen_hdl::verilog`), the harness, the Verilator
 //! version, these flags, the CPU and the trace flag: an unchanged design never rebuilds.
-//! `-Wall` makes every lint warning that the waiver file does not waive fatal, so a build is
-//! also a lint check.
+//! `-Wall` makes every lint warning that the Verilog does not waive fatal, so a build is also a
+//! lint check.
 //! `$SNAPGEN_VERILATOR` overrides the `verilator` binary.
 
 use std::fs;
@@ -33,8 +34,6 @@ use crate::SimError;
 pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
 /// The harness source of virtual-board builds (the I/O top).
 pub const IO_HARNESS_CPP: &str = include_str!("../harness/io_harness.cpp");
-/// The Verilator waiver file for the generated core.
-pub const WAIVERS_VLT: &str = include_str!("../../hdl/verilator.vlt");
 
 /// C++ flags of every build (see the module documentation).
 const CFLAGS: &str = "-fPIC -march=native -fno-semantic-interposition";
@@ -130,26 +129,40 @@ pub struct Built {
 /// [`crate::wrapper::cosim_top`]), with VCD tracing if `trace`.
 pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
     let verilog = crate::wrapper::cosim_top(core_verilog);
-    build_with("core", "top.v", &verilog, HARNESS_CPP, trace)
+    let layout = crate::fabric::core_layout_header();
+    build_with("core", "top", &verilog, HARNESS_CPP, &layout, trace)
 }
 
-/// Builds (or finds in the cache) the virtual-board library for the I/O top `io_verilog`.
-pub fn build_io(io_verilog: &str) -> Result<Built, SimError> {
-    build_with("io", "io_top.v", io_verilog, IO_HARNESS_CPP, false)
+/// Builds (or finds in the cache) the library of the I/O top `io_verilog` (the virtual board
+/// and the I/O co-simulation), with VCD tracing if `trace`.
+pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "io",
+        snapgen_hdl::verilog::IO_PREFIX,
+        io_verilog,
+        IO_HARNESS_CPP,
+        &crate::io::io_layout_header(),
+        trace,
+    )
 }
 
+/// Builds `verilog` (top module `top_module`, written to `TOP_MODULE.v`) with `harness` and its
+/// generated word layout `layout` (`snapgen_layout.h`); the C++ class is `Vtop` whatever the
+/// top module is called.
 fn build_with(
     tag: &str,
-    file: &str,
+    top_module: &str,
     verilog: &str,
     harness: &str,
+    layout: &str,
     trace: bool,
 ) -> Result<Built, SimError> {
     let version = verilator_version()?;
     let key = fnv1a(&[
+        top_module.as_bytes(),
         verilog.as_bytes(),
-        WAIVERS_VLT.as_bytes(),
         harness.as_bytes(),
+        layout.as_bytes(),
         version.as_bytes(),
         CFLAGS.as_bytes(),
         host_cpu().as_bytes(),
@@ -183,15 +196,23 @@ fn build_with(
         let p = tmp.join(name);
         fs::write(&p, text).map_err(io("cannot write", &p))
     };
-    write(file, verilog)?;
-    write("verilator.vlt", WAIVERS_VLT)?;
+    let file = format!("{top_module}.v");
+    write(&file, verilog)?;
     write("harness.cpp", harness)?;
+    write("snapgen_layout.h", layout)?;
     let log = tmp.join("build.log");
     let mut cmd = Command::new(verilator_bin());
     cmd.current_dir(&tmp)
         .args(["--cc", "--exe", "--build", "-j", "2", "-O3", "-Wall"])
         .args(["--x-assign", "fast", "--x-initial", "fast", "--noassert"])
-        .args(["--top-module", "top", "--Mdir", "obj"])
+        .args([
+            "--top-module",
+            top_module,
+            "--prefix",
+            "Vtop",
+            "--Mdir",
+            "obj",
+        ])
         .args([
             "-CFLAGS",
             &format!("{CFLAGS} -DSNAPGEN_TRACE={}", u8::from(trace)),
@@ -201,7 +222,7 @@ fn build_with(
     if trace {
         cmd.arg("--trace");
     }
-    cmd.args(["verilator.vlt", file, "harness.cpp"]);
+    cmd.args([file.as_str(), "harness.cpp"]);
     let out = cmd.output().map_err(|_| missing_verilator())?;
     let mut text = out.stdout.clone();
     text.extend_from_slice(&out.stderr);

@@ -4,15 +4,174 @@ use std::ffi::{c_char, c_void, CString};
 use std::path::{Path, PathBuf};
 
 use libloading::Library;
+use snapgen_hdl::{
+    ADDR_BITS, A_BITS, D_BITS, INDEX_BITS, J_BITS, POSITION_BITS, TICK_BITS, V_BITS, X_BITS,
+};
 use snapgen_model::chain::wrap;
 use snapgen_model::{CoreInputs, CoreOutputs, Format};
 
+use crate::layout::{harness_header, pack, Port, Slot};
 use crate::SimError;
 
-/// Input words per `set` call (must match the harness).
-pub const IN_WORDS: usize = 15;
-/// Output words per clock (must match the harness).
-pub const OUT_WORDS: usize = 19;
+/// The core's inputs, in the harness's word order (the wrapper registers each of them).
+pub const CORE_INPUTS: [Port; 15] = [
+    Port {
+        name: "reset",
+        bits: 1,
+    },
+    Port {
+        name: "tick_div",
+        bits: TICK_BITS as u32,
+    },
+    Port {
+        name: "start",
+        bits: 1,
+    },
+    Port {
+        name: "abort_move",
+        bits: 1,
+    },
+    Port {
+        name: "stop",
+        bits: 1,
+    },
+    Port {
+        name: "load",
+        bits: 1,
+    },
+    Port {
+        name: "load_position",
+        bits: POSITION_BITS as u32,
+    },
+    Port {
+        name: "stop_jerk",
+        bits: D_BITS as u32,
+    },
+    Port {
+        name: "stop_accel",
+        bits: D_BITS as u32,
+    },
+    Port {
+        name: "write_enable",
+        bits: 1,
+    },
+    Port {
+        name: "write_address",
+        bits: ADDR_BITS as u32,
+    },
+    Port {
+        name: "write_ticks",
+        bits: TICK_BITS as u32,
+    },
+    Port {
+        name: "write_snap",
+        bits: D_BITS as u32,
+    },
+    Port {
+        name: "count_enable",
+        bits: 1,
+    },
+    Port {
+        name: "count_value",
+        bits: INDEX_BITS as u32,
+    },
+];
+
+/// The core's outputs, in [`crate::cosim::Register`] order.
+pub const CORE_OUTPUTS: [Port; 19] = [
+    Port {
+        name: "x",
+        bits: X_BITS as u32,
+    },
+    Port {
+        name: "v",
+        bits: V_BITS as u32,
+    },
+    Port {
+        name: "a",
+        bits: A_BITS as u32,
+    },
+    Port {
+        name: "j",
+        bits: J_BITS as u32,
+    },
+    Port {
+        name: "position",
+        bits: POSITION_BITS as u32,
+    },
+    Port {
+        name: "segment",
+        bits: INDEX_BITS as u32,
+    },
+    Port {
+        name: "busy",
+        bits: 1,
+    },
+    Port {
+        name: "done",
+        bits: 1,
+    },
+    Port {
+        name: "aborted",
+        bits: 1,
+    },
+    Port {
+        name: "stopping",
+        bits: 1,
+    },
+    Port {
+        name: "stop_over",
+        bits: 1,
+    },
+    Port {
+        name: "tick",
+        bits: 1,
+    },
+    Port {
+        name: "heading_pos",
+        bits: 1,
+    },
+    Port {
+        name: "heading_neg",
+        bits: 1,
+    },
+    Port {
+        name: "at_rest",
+        bits: 1,
+    },
+    Port {
+        name: "active_bank",
+        bits: 1,
+    },
+    Port {
+        name: "standby_count",
+        bits: INDEX_BITS as u32,
+    },
+    Port {
+        name: "tick_count",
+        bits: TICK_BITS as u32,
+    },
+    Port {
+        name: "ticks",
+        bits: 64,
+    },
+];
+
+const IN_LAYOUT: ([Slot; 15], usize) = pack(&CORE_INPUTS);
+const OUT_LAYOUT: ([Slot; 19], usize) = pack(&CORE_OUTPUTS);
+/// Where each input is in the input words.
+pub const IN_SLOTS: [Slot; 15] = IN_LAYOUT.0;
+/// Where each output is in a clock's output words.
+pub const OUT_SLOTS: [Slot; 19] = OUT_LAYOUT.0;
+/// Input words per `set` call.
+pub const IN_WORDS: usize = IN_LAYOUT.1;
+/// Output words per clock.
+pub const OUT_WORDS: usize = OUT_LAYOUT.1;
+
+/// The core harness's generated header (`snapgen_layout.h`).
+pub fn core_layout_header() -> String {
+    harness_header(&CORE_INPUTS, &CORE_OUTPUTS)
+}
 
 type NewFn = unsafe extern "C" fn(*const c_char, u64, u64) -> *mut c_void;
 type FreeFn = unsafe extern "C" fn(*mut c_void);
@@ -99,24 +258,7 @@ impl Fabric {
 
     /// Applies inputs (held until the next call).
     pub fn set(&mut self, i: &CoreInputs) {
-        let snap = i.write_snap as u128;
-        let words: [u32; IN_WORDS] = [
-            u32::from(i.reset),
-            i.tick_div,
-            u32::from(i.start),
-            u32::from(i.stop),
-            u32::from(i.write_enable),
-            u32::from(i.write_address),
-            i.write_ticks,
-            snap as u32,
-            (snap >> 32) as u32,
-            (snap >> 64) as u32,
-            (snap >> 96) as u32,
-            u32::from(i.count_enable),
-            u32::from(i.count_value),
-            u32::from(i.cruise_value),
-            u32::from(i.soft_stop),
-        ];
+        let words = encode_inputs(i);
         // SAFETY: `handle` is a live instance; `words` has IN_WORDS words.
         unsafe { (self.set)(self.handle, words.as_ptr()) }
     }
@@ -136,59 +278,96 @@ impl Drop for Fabric {
     }
 }
 
-/// Encodes outputs in the harness's word layout (the inverse of [`decode`]). The co-simulation
-/// compares the fabric's words against the model without building this array (its
-/// `differs`, tested against this function).
-#[inline]
+/// The inputs in the harness's word layout.
+pub fn encode_inputs(i: &CoreInputs) -> [u32; IN_WORDS] {
+    let mut w = [0u32; IN_WORDS];
+    let values: [u128; 15] = [
+        u128::from(i.reset),
+        u128::from(i.tick_div),
+        u128::from(i.start),
+        u128::from(i.abort),
+        u128::from(i.stop),
+        u128::from(i.load),
+        u128::from(i.load_position),
+        i.stop_limits.jerk as u128,
+        i.stop_limits.accel as u128,
+        u128::from(i.write_enable),
+        u128::from(i.write_address),
+        u128::from(i.write_ticks),
+        i.write_snap as u128,
+        u128::from(i.count_enable),
+        u128::from(i.count_value),
+    ];
+    for (slot, v) in IN_SLOTS.iter().zip(values) {
+        slot.put(&mut w, v);
+    }
+    w
+}
+
+/// Encodes outputs in the harness's word layout (the inverse of [`decode`]): what the
+/// co-simulation compares the fabric's words with, on every clock.
+///
+/// One `put` per register, each with a constant register: every slot, shift and mask then
+/// folds into straight-line code (a loop over the registers did not, and cost three times the
+/// Verilated core's own clock). Every register is written (checked by a test).
+#[inline(always)]
 pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
+    use crate::cosim::Register as R;
     let mut w = [0u32; OUT_WORDS];
-    let mut wide = |k: usize, v: i128, bits: u32| {
-        let u = (v as u128) & (u128::MAX >> (128 - bits));
-        w[k] = u as u32;
-        w[k + 1] = (u >> 32) as u32;
-        w[k + 2] = (u >> 64) as u32;
-        w[k + 3] = (u >> 96) as u32;
-    };
-    wide(0, o.x, f.widths.x);
-    wide(4, o.v, f.widths.v);
-    wide(8, o.a, f.widths.a);
-    wide(12, o.j, f.widths.j);
-    w[16] = o.position;
-    w[17] = u32::from(o.segment)
-        | u32::from(o.busy) << 8
-        | u32::from(o.done) << 9
-        | u32::from(o.aborted) << 10
-        | u32::from(o.tick) << 11
-        | u32::from(o.active_bank) << 12
-        | u32::from(o.standby_count) << 16;
-    w[18] = o.tick_count;
+    macro_rules! put {
+        ($($r:expr),* $(,)?) => {
+            $(OUT_SLOTS[$r as usize].put(&mut w, $r.bits_of(o, f));)*
+            const _: () = assert!([$($r as usize),*].len() == R::ALL.len());
+        };
+    }
+    put!(
+        R::X,
+        R::V,
+        R::A,
+        R::J,
+        R::Position,
+        R::Segment,
+        R::Busy,
+        R::Done,
+        R::Aborted,
+        R::Stopping,
+        R::StopOver,
+        R::Tick,
+        R::HeadingPos,
+        R::HeadingNeg,
+        R::AtRest,
+        R::ActiveBank,
+        R::StandbyCount,
+        R::TickCount,
+        R::Ticks,
+    );
     w
 }
 
 /// Decodes one clock's output words.
-#[inline]
 pub fn decode(w: &[u32], f: &Format) -> CoreOutputs {
-    let wide = |k: usize, bits: u32| {
-        let u = u128::from(w[k])
-            | (u128::from(w[k + 1]) << 32)
-            | (u128::from(w[k + 2]) << 64)
-            | (u128::from(w[k + 3]) << 96);
-        wrap(u as i128, bits)
-    };
-    let flags = w[17];
+    use crate::cosim::Register as R;
+    let get = |r: R| OUT_SLOTS[r as usize].get(w);
+    let wide = |r: R, bits: u32| wrap(get(r) as i128, bits);
+    let flag = |r: R| get(r) == 1;
     CoreOutputs {
-        x: wide(0, f.widths.x),
-        v: wide(4, f.widths.v),
-        a: wide(8, f.widths.a),
-        j: wide(12, f.widths.j),
-        position: w[16],
-        segment: (flags & 0xff) as u8,
-        busy: flags >> 8 & 1 == 1,
-        done: flags >> 9 & 1 == 1,
-        aborted: flags >> 10 & 1 == 1,
-        tick: flags >> 11 & 1 == 1,
-        active_bank: flags >> 12 & 1 == 1,
-        standby_count: (flags >> 16 & 0x3f) as u8,
-        tick_count: w[18],
+        x: wide(R::X, f.widths.x),
+        v: wide(R::V, f.widths.v),
+        a: wide(R::A, f.widths.a),
+        j: wide(R::J, f.widths.j),
+        position: get(R::Position) as u32,
+        segment: get(R::Segment) as u8,
+        busy: flag(R::Busy),
+        done: flag(R::Done),
+        aborted: flag(R::Aborted),
+        stopping: flag(R::Stopping),
+        stop_over: flag(R::StopOver),
+        tick: flag(R::Tick),
+        heading: i8::from(flag(R::HeadingPos)) - i8::from(flag(R::HeadingNeg)),
+        at_rest: flag(R::AtRest),
+        active_bank: flag(R::ActiveBank),
+        standby_count: get(R::StandbyCount) as u8,
+        tick_count: get(R::TickCount) as u32,
+        ticks: get(R::Ticks) as u64,
     }
 }

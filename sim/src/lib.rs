@@ -9,11 +9,17 @@
 //! * [`fabric`] loads the library and drives it.
 //! * [`cosim`] runs both in lockstep and reports the first mismatch.
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
+//! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
+//!   model under random command streams; [`board`] is the virtual board on it.
 
 pub mod board;
 pub mod build;
+pub mod closed_loop;
 pub mod cosim;
 pub mod fabric;
+pub mod io;
+pub mod io_cosim;
+pub mod layout;
 pub mod moves;
 pub mod wrapper;
 

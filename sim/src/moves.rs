@@ -1,11 +1,14 @@
 //! Random move streams for co-simulation: positive and negative, tiny and long, every order,
 //! limits drawn log-uniformly so that each limit is the active one in some moves and phases
-//! are empty in others; a few moves run with a tick divider, a few are aborted midway and a few
-//! get a controlled stop.
+//! are empty in others; a few moves run with a tick divider, a few are aborted midway and many
+//! get a controlled stop at a random clock (with random stop limits, some of them too low for
+//! the state the stop begins from), some with a second request or an abort during the stop.
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use snapgen_model::{Method, MoveRequest};
+use snapgen_model::format::Quantity;
+use snapgen_model::stop::StopLimits;
+use snapgen_model::{Format, Method, MoveRequest};
 
 /// Which planners the stream uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,27 +46,55 @@ pub struct MoveSpec {
     /// Clocks per tick minus one.
     pub tick_div: u32,
     /// Stop (abort) this many clocks after the start, if set.
-    pub stop_after: Option<u64>,
+    pub abort_after: Option<u64>,
     /// Controlled stop this many clocks after the start, if set.
-    pub soft_stop_after: Option<u64>,
+    pub stop_after: Option<u64>,
+    /// The stop's limits (raw, at `ts`).
+    pub stop_limits: StopLimits,
+    /// Request the stop again this many clocks after the first request (ignored by the core).
+    pub stop_again_after: Option<u64>,
+    /// Abort this many clocks after the stop request (cancels the stop).
+    pub abort_stop_after: Option<u64>,
+}
+
+impl MoveSpec {
+    /// `request` planned at `ts`, played to its end at one tick per clock.
+    pub fn plain(request: MoveRequest, ts: f64) -> Self {
+        MoveSpec {
+            request,
+            ts,
+            tick_div: 0,
+            abort_after: None,
+            stop_after: None,
+            stop_limits: StopLimits::default(),
+            stop_again_after: None,
+            abort_stop_after: None,
+        }
+    }
 }
 
 /// A deterministic stream of random moves.
 pub struct MoveStream {
     rng: StdRng,
     mix: OrderMix,
+    stop_share: f64,
 }
+
+/// The share of moves given a controlled stop by default.
+pub const DEFAULT_STOP_SHARE: f64 = 0.25;
 
 fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
     rng.gen_range(lo.ln()..=hi.ln()).exp()
 }
 
 impl MoveStream {
-    /// The stream for `seed`.
-    pub fn new(seed: u64, mix: OrderMix) -> Self {
+    /// The stream for `seed`, with a controlled stop in a share `stop_share` of the moves
+    /// (each stopping tick takes the stop unit's decision, about 130 clocks).
+    pub fn new(seed: u64, mix: OrderMix, stop_share: f64) -> Self {
         MoveStream {
             rng: StdRng::seed_from_u64(seed),
             mix,
+            stop_share: stop_share.clamp(0.0, 1.0),
         }
     }
 
@@ -125,22 +156,50 @@ impl MoveStream {
         } else {
             0
         };
-        let stop_after = if r.gen_bool(0.03) {
+        let abort_after = if r.gen_bool(0.03) {
             Some(r.gen_range(1..2000))
         } else {
             None
         };
-        let soft_stop_after = if stop_after.is_none() && r.gen_bool(0.05) {
-            Some(r.gen_range(1..20_000))
+        let stop_after = if abort_after.is_none() && r.gen_bool(self.stop_share) {
+            Some(log_uniform(r, 1.0, 400_000.0) as u64)
         } else {
             None
         };
+        // Stop limits, raw at this Ts: an acceleration that stops the move's top speed in
+        // 2 to 1000 ticks and a jerk that reaches it in 1 to 500 ticks, so that stops last
+        // tens to about a thousand ticks (each stop tick waits for the stop unit's decision)
+        // and some begin decelerating harder than their limits allow.
+        let f = Format::with_ts(ts);
+        let v_raw = (v * f.scale(Quantity::Velocity)).max(1.0);
+        let a_raw = a * f.scale(Quantity::Acceleration);
+        let mut accel = ((v_raw / log_uniform(r, 2.0, 1000.0)) as i128).max(1);
+        if r.gen_bool(0.4) {
+            // Below the move's own acceleration: a stop during its deceleration begins over.
+            accel = ((a_raw * log_uniform(r, 0.05, 1.0)).max(v_raw / 1000.0) as i128).max(1);
+        }
+        let mut jerk = ((accel as f64 / log_uniform(r, 1.0, 500.0)) as i128).clamp(1, accel);
+        if r.gen_bool(0.4) {
+            // Below the move's own jerk: a stop while the move's acceleration is high may
+            // not release it in time.
+            let j_raw = j * f.scale(Quantity::Jerk) * log_uniform(r, 0.01, 1.0);
+            jerk = (j_raw.max(accel as f64 / 500.0) as i128).clamp(1, accel);
+        }
+        let stop_again_after = stop_after
+            .filter(|_| r.gen_bool(0.2))
+            .map(|_| r.gen_range(1..3000));
+        let abort_stop_after = stop_after
+            .filter(|_| r.gen_bool(0.1))
+            .map(|_| r.gen_range(1..3000));
         MoveSpec {
             request: MoveRequest { distance, method },
             ts,
             tick_div,
+            abort_after,
             stop_after,
-            soft_stop_after,
+            stop_limits: StopLimits { jerk, accel },
+            stop_again_after,
+            abort_stop_after,
         }
     }
 }

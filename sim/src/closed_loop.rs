@@ -1,0 +1,379 @@
+//! The closed loop at device level: the Verilated I/O top drives a simulated motor
+//! (`snapgen_plant::Plant`) through its PWM, direction and amplifier-enable pins and reads the
+//! motor's encoder, while the device model, fed the same pins on every clock, must produce the
+//! same outputs — PWM, direction, amplifier, the UART and the whole status block — on every
+//! clock. A host on the UART configures the axis, uploads programs and starts them, as
+//! `snapgen send` does.
+//!
+//! Clock by clock, one plant step at a time: the pins of the step's clocks (the host's UART
+//! line, the encoder heading for the plant's count, the index) are known before it (the plant
+//! moves only at the end of a step), so the fabric runs them in one call; then every clock's
+//! outputs are compared with the model's, the bridge reads the fabric's pins clock by clock,
+//! and the motor is integrated. Without the fabric (`fabric: false`) the model drives the
+//! motor: the same loop, model only.
+
+use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
+use snapgen_model::io::servo::ServoConfig;
+use snapgen_model::peer::Peer;
+use snapgen_model::protocol::{Command, Decoded, Decoder, Param, Reason, Reply};
+use snapgen_model::stop::StopLimits;
+use snapgen_model::{Program, FRAC_BITS};
+use snapgen_plant::fast::LoopSample;
+use snapgen_plant::plant::StepError;
+use snapgen_plant::{BridgePins, Physical, Plant};
+
+use crate::build::build_io;
+use crate::io::{
+    decode_outputs, encode_inputs, encode_outputs, FabricIo, IoSignal, IN_WORDS, OUT_WORDS,
+};
+use crate::SimError;
+
+/// The first clock where the fabric and the model disagreed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoopMismatch {
+    /// Clock.
+    pub clock: u64,
+    /// The first signal that differs.
+    pub signal: IoSignal,
+    /// The model's value.
+    pub expected: u128,
+    /// The fabric's.
+    pub actual: u128,
+}
+
+/// What went wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum LoopError {
+    /// Verilator or the library.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The plant's step.
+    #[error(transparent)]
+    Step(#[from] StepError),
+    /// No reply from the device.
+    #[error("no reply to {0} within {1} s of simulated time")]
+    NoReply(String, f64),
+    /// The device refused a command.
+    #[error("the device refused {command}: {}", reason.name())]
+    Nak {
+        /// The command.
+        command: String,
+        /// Why.
+        reason: Reason,
+    },
+    /// An unexpected reply.
+    #[error("unexpected reply to {command}: {reply:?}")]
+    Unexpected {
+        /// The command.
+        command: String,
+        /// The reply.
+        reply: Box<Reply>,
+    },
+}
+
+/// The axis's configuration for a closed loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisSetup {
+    /// PWM period (clocks).
+    pub pwm_period: u16,
+    /// The controller.
+    pub servo: ServoConfig,
+    /// The stop's limits (raw).
+    pub stop: StopLimits,
+}
+
+/// The closed loop.
+pub struct ClosedLoop {
+    design: Design,
+    dev: Device,
+    fabric: Option<FabricIo>,
+    peer: Peer,
+    plant: Plant,
+    rad_per_count: f64,
+    seq: u8,
+    decoder: Decoder,
+    replies: Vec<(u8, Reply)>,
+    inputs: Vec<IoInputs>,
+    words: Vec<[u32; IN_WORDS]>,
+    outs: Vec<u32>,
+    clock: u64,
+    mismatches: u64,
+    first_mismatch: Option<LoopMismatch>,
+    record_every: u64,
+    samples: Vec<LoopSample>,
+    fault: Option<(u64, IoSignal, u32)>,
+    /// Clocks at which a program began to play (the model core's `busy` rising).
+    starts: Vec<u64>,
+    was_busy: bool,
+}
+
+impl ClosedLoop {
+    /// A loop of `design` (on the Verilated I/O top when `fabric`, built or found in the build
+    /// cache) around the plant `p` stepped every `step_s`, recording a sample every
+    /// `record_every` clocks. The board comes out of reset; the motor rests at angle 0.
+    pub fn new(
+        design: &Design,
+        p: &Physical,
+        step_s: f64,
+        fabric: bool,
+        record_every: u64,
+    ) -> Result<Self, LoopError> {
+        let plant = Plant::new(p, f64::from(design.clock_hz), step_s)?;
+        let fabric = if fabric {
+            let built = build_io(&snapgen_hdl::verilog::io_top_verilog(design), false)?;
+            Some(FabricIo::open(&built.library, None)?)
+        } else {
+            None
+        };
+        let mut peer = Peer::new(design.dividers.uart_divisor);
+        peer.wiring = design.input_polarity;
+        peer.index_period = if p.index { p.counts_per_rev } else { 0 };
+        peer.drive_encoder(0);
+        Ok(ClosedLoop {
+            design: *design,
+            dev: Device::new(design),
+            fabric,
+            peer,
+            rad_per_count: p.rad_per_count(),
+            plant,
+            seq: 0,
+            decoder: Decoder::new(),
+            replies: Vec::new(),
+            inputs: Vec::new(),
+            words: Vec::new(),
+            outs: Vec::new(),
+            clock: 0,
+            mismatches: 0,
+            first_mismatch: None,
+            record_every: record_every.max(1),
+            samples: Vec::new(),
+            fault: None,
+            starts: Vec::new(),
+            was_busy: false,
+        })
+    }
+
+    /// Test hook: flip `bit` of `signal` in the fabric's outputs at `clock`.
+    pub fn inject_fault(&mut self, clock: u64, signal: IoSignal, bit: u32) {
+        self.fault = Some((clock, signal, bit));
+    }
+
+    /// True when the Verilated I/O top drives the motor.
+    pub fn on_fabric(&self) -> bool {
+        self.fabric.is_some()
+    }
+
+    /// Clocks whose outputs differed (fabric against model).
+    pub fn mismatches(&self) -> u64 {
+        self.mismatches
+    }
+
+    /// The first of them.
+    pub fn first_mismatch(&self) -> Option<LoopMismatch> {
+        self.first_mismatch
+    }
+
+    /// Clocks run.
+    pub fn clocks(&self) -> u64 {
+        self.clock
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.clock as f64 / f64::from(self.design.clock_hz)
+    }
+
+    /// The device model.
+    pub fn device(&self) -> &Device {
+        &self.dev
+    }
+
+    /// The plant.
+    pub fn plant(&self) -> &Plant {
+        &self.plant
+    }
+
+    /// When each program began to play (s): the clock its first tick's program was taken.
+    pub fn starts(&self) -> Vec<f64> {
+        let hz = f64::from(self.design.clock_hz);
+        self.starts.iter().map(|&c| c as f64 / hz).collect()
+    }
+
+    /// The samples recorded so far (taken out).
+    pub fn take_samples(&mut self) -> Vec<LoopSample> {
+        std::mem::take(&mut self.samples)
+    }
+
+    /// Runs at least `clocks` clocks (whole plant steps).
+    pub fn run(&mut self, clocks: u64) {
+        let end = self.clock + clocks;
+        while self.clock < end {
+            self.step();
+        }
+    }
+
+    /// Runs until `t` seconds of simulated time.
+    pub fn run_until(&mut self, t: f64) {
+        let end = (t * f64::from(self.design.clock_hz)).round() as u64;
+        while self.clock < end {
+            self.step();
+        }
+    }
+
+    /// One plant step.
+    fn step(&mut self) {
+        let n = self.plant.step_clocks() as usize;
+        self.inputs.clear();
+        self.words.clear();
+        for _ in 0..n {
+            let i = self.peer.inputs();
+            self.words.push(encode_inputs(&i));
+            self.inputs.push(i);
+        }
+        if let Some(fab) = self.fabric.as_mut() {
+            fab.run(&self.words, &mut self.outs);
+        }
+        for k in 0..n {
+            let om = self.dev.clock(&self.inputs[k]);
+            let o = match &self.fabric {
+                None => om,
+                Some(_) => {
+                    let words = &mut self.outs[k * OUT_WORDS..(k + 1) * OUT_WORDS];
+                    if let Some((at, signal, bit)) = self.fault {
+                        if at == self.clock {
+                            signal.flip(words, bit);
+                        }
+                    }
+                    let want = encode_outputs(&om);
+                    if words != want.as_slice() {
+                        self.mismatches += 1;
+                        if self.first_mismatch.is_none() {
+                            let signal = IoSignal::all()
+                                .find(|s| s.value(words) != s.value(&want))
+                                .expect("every output bit belongs to a signal (tested)");
+                            self.first_mismatch = Some(LoopMismatch {
+                                clock: self.clock,
+                                signal,
+                                expected: signal.value(&want),
+                                actual: signal.value(words),
+                            });
+                        }
+                    }
+                    decode_outputs(words)
+                }
+            };
+            let busy = self.dev.core().busy();
+            if busy && !self.was_busy {
+                self.starts.push(self.clock);
+            }
+            self.was_busy = busy;
+            self.peer.observe(&o);
+            self.plant.clock(BridgePins {
+                pwm: o.pwm,
+                dir: o.dir,
+                enable: o.amplifier,
+            });
+            self.clock += 1;
+            if self.clock % self.record_every == 0 {
+                self.record(&o);
+            }
+        }
+        self.peer.drive_encoder(self.plant.count());
+        for b in self.peer.take_received() {
+            if let Some(Decoded::Frame(f)) = self.decoder.push(b) {
+                if let Some(r) = Reply::from_frame(&f) {
+                    if !matches!(r, Reply::Telemetry(_)) {
+                        self.replies.push((f.seq, r));
+                    }
+                }
+            }
+        }
+    }
+
+    fn record(&mut self, o: &IoOutputs) {
+        let st = self.plant.state();
+        let x = self.dev.core().chain().x;
+        let d = self.rad_per_count;
+        self.samples.push(LoopSample {
+            t: self.time(),
+            reference: x as f64 / 2f64.powi(FRAC_BITS as i32) * d - 0.5 * d,
+            encoder: f64::from(o.status.encoder) * d,
+            theta: st.theta,
+            omega: st.omega,
+            duty: o.status.duty,
+            volts: self.plant.volts(),
+        });
+    }
+
+    /// Sends `c` and runs until its reply (at most a second of simulated time).
+    pub fn ask(&mut self, c: Command) -> Result<Reply, LoopError> {
+        self.seq = self.seq.wrapping_add(1).max(1);
+        let seq = self.seq;
+        self.peer
+            .send(&c.to_frame(seq, &self.design.format).to_bytes());
+        let deadline = self.clock + u64::from(self.design.clock_hz);
+        while self.clock < deadline {
+            self.step();
+            if let Some(k) = self.replies.iter().position(|(s, _)| *s == seq) {
+                return match self.replies.remove(k).1 {
+                    Reply::Nak { reason, .. } => Err(LoopError::Nak {
+                        command: c.name().to_string(),
+                        reason,
+                    }),
+                    r => Ok(r),
+                };
+            }
+        }
+        Err(LoopError::NoReply(c.name().to_string(), 1.0))
+    }
+
+    /// Sends `c`, which must be acknowledged.
+    pub fn command(&mut self, c: Command) -> Result<(), LoopError> {
+        match self.ask(c)? {
+            Reply::Ack { .. } => Ok(()),
+            r => Err(LoopError::Unexpected {
+                command: c.name().to_string(),
+                reply: Box::new(r),
+            }),
+        }
+    }
+
+    /// Configures the axis (PWM, controller, stop limits; the watchdog off: the loop's host
+    /// polls at its own pace) and powers it.
+    pub fn setup(&mut self, s: &AxisSetup) -> Result<(), LoopError> {
+        let c = &s.servo;
+        for (param, value) in [
+            (Param::WatchdogMs, 0),
+            (Param::PwmPeriod, i128::from(s.pwm_period)),
+            (Param::ServoPeriod, i128::from(c.period)),
+            (Param::Kp, i128::from(c.kp)),
+            (Param::Ki, i128::from(c.ki)),
+            (Param::Kd, i128::from(c.kd)),
+            (Param::Kv, i128::from(c.kv)),
+            (Param::Ka, i128::from(c.ka)),
+            (Param::IntegralLimit, i128::from(c.integral_limit)),
+            (Param::OutputLimit, i128::from(c.output_limit)),
+            (Param::FollowingLimit, i128::from(c.following_limit)),
+            (Param::DFilter, i128::from(c.d_filter)),
+            (Param::StopJerk, s.stop.jerk),
+            (Param::StopAccel, s.stop.accel),
+        ] {
+            self.command(Command::Configure { param, value })?;
+        }
+        self.command(Command::Power { on: true })
+    }
+
+    /// Uploads `program` and starts it.
+    pub fn start(&mut self, program: &Program) -> Result<(), LoopError> {
+        for (k, s) in program.segments.iter().enumerate() {
+            self.command(Command::LoadSegment {
+                index: k as u8,
+                segment: *s,
+            })?;
+        }
+        self.command(Command::Commit {
+            count: program.segments.len() as u8,
+        })?;
+        self.command(Command::Start)
+    }
+}

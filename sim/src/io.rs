@@ -1,0 +1,389 @@
+//! The Verilated I/O top (`snapgen_io`), loaded from the shared library [`crate::build`] makes
+//! with `harness/io_harness.cpp`: one call runs many clocks with every clock's pins in and
+//! every clock's outputs out. Its port tables are the single source of the harness's word
+//! layout (`snapgen_layout.h`) and of the Rust encoders and decoders below; its outputs are
+//! compared with `snapgen_model::device::Device` on every clock ([`crate::io_cosim`]) and drive
+//! the virtual board ([`crate::board`]).
+
+use std::ffi::{c_char, c_void, CString};
+use std::path::Path;
+
+use libloading::Library;
+use snapgen_hdl::status_block::STATUS_BITS;
+use snapgen_model::device::{IoInputs, IoOutputs};
+use snapgen_model::protocol::{payload_bytes, Status, STATUS_FIELDS};
+
+use crate::fabric::VcdWindow;
+use crate::layout::{harness_header, pack, Port, Slot};
+use crate::SimError;
+
+/// The I/O top's inputs, in the harness's word order.
+pub const IO_INPUTS: [Port; 8] = [
+    Port {
+        name: "reset",
+        bits: 1,
+    },
+    Port {
+        name: "uart_rx",
+        bits: 1,
+    },
+    Port {
+        name: "enc_a",
+        bits: 1,
+    },
+    Port {
+        name: "enc_b",
+        bits: 1,
+    },
+    Port {
+        name: "enc_i",
+        bits: 1,
+    },
+    Port {
+        name: "limit_pos",
+        bits: 1,
+    },
+    Port {
+        name: "limit_neg",
+        bits: 1,
+    },
+    Port {
+        name: "estop",
+        bits: 1,
+    },
+];
+
+/// The I/O top's outputs, in [`IoSignal`] order (the status block last).
+pub const IO_OUTPUTS: [Port; 9] = [
+    Port {
+        name: "uart_tx",
+        bits: 1,
+    },
+    Port {
+        name: "pwm",
+        bits: 1,
+    },
+    Port {
+        name: "dir",
+        bits: 1,
+    },
+    Port {
+        name: "amplifier",
+        bits: 1,
+    },
+    Port {
+        name: "led_idle",
+        bits: 1,
+    },
+    Port {
+        name: "led_busy",
+        bits: 1,
+    },
+    Port {
+        name: "led_fault",
+        bits: 1,
+    },
+    Port {
+        name: "led_heartbeat",
+        bits: 1,
+    },
+    Port {
+        name: "status",
+        bits: STATUS_BITS as u32,
+    },
+];
+
+const IN_LAYOUT: ([Slot; 8], usize) = pack(&IO_INPUTS);
+const OUT_LAYOUT: ([Slot; 9], usize) = pack(&IO_OUTPUTS);
+/// Where each input is in a clock's input words.
+pub const IN_SLOTS: [Slot; 8] = IN_LAYOUT.0;
+/// Where each output is in a clock's output words.
+pub const OUT_SLOTS: [Slot; 9] = OUT_LAYOUT.0;
+/// Input words per clock.
+pub const IN_WORDS: usize = IN_LAYOUT.1;
+/// Output words per clock.
+pub const OUT_WORDS: usize = OUT_LAYOUT.1;
+/// Where the status block starts in a clock's output words.
+const STATUS_WORD: usize = OUT_SLOTS[8].word;
+
+const _: () = assert!(8 * payload_bytes(&STATUS_FIELDS) == STATUS_BITS);
+
+/// The harness's generated header (`snapgen_layout.h`).
+pub fn io_layout_header() -> String {
+    harness_header(&IO_INPUTS, &IO_OUTPUTS)
+}
+
+/// A compared output: a pin, or a field of the status block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IoSignal {
+    /// One of the one-bit outputs (index into [`IO_OUTPUTS`]).
+    Pin(usize),
+    /// A field of the status block (index into `STATUS_FIELDS`).
+    Status(usize),
+}
+
+impl IoSignal {
+    /// Every compared signal.
+    pub fn all() -> impl Iterator<Item = IoSignal> {
+        (0..8)
+            .map(IoSignal::Pin)
+            .chain((0..STATUS_FIELDS.len()).map(IoSignal::Status))
+    }
+
+    /// Its name (`uart_tx`, …, `status.flags`, …).
+    pub fn name(self) -> String {
+        match self {
+            IoSignal::Pin(k) => IO_OUTPUTS[k].name.to_string(),
+            IoSignal::Status(k) => format!("status.{}", STATUS_FIELDS[k].name),
+        }
+    }
+
+    /// Its width in bits.
+    pub fn bits(self) -> u32 {
+        match self {
+            IoSignal::Pin(_) => 1,
+            IoSignal::Status(k) => 8 * STATUS_FIELDS[k].bytes as u32,
+        }
+    }
+
+    /// Its value in a clock's output words.
+    pub fn value(self, w: &[u32]) -> u128 {
+        match self {
+            IoSignal::Pin(k) => OUT_SLOTS[k].get(w),
+            IoSignal::Status(k) => {
+                let f = STATUS_FIELDS[k];
+                let bytes = status_bytes(w);
+                (0..f.bytes).fold(0u128, |v, i| {
+                    v | (u128::from(bytes[f.offset + i]) << (8 * i))
+                })
+            }
+        }
+    }
+
+    /// The words with this signal's bit `bit` (modulo its width) flipped.
+    pub fn flip(self, w: &mut [u32], bit: u32) {
+        let bit = bit % self.bits();
+        match self {
+            IoSignal::Pin(k) => {
+                let s = OUT_SLOTS[k];
+                s.put(w, s.get(w) ^ 1);
+            }
+            IoSignal::Status(k) => {
+                let at = 8 * STATUS_FIELDS[k].offset as u32 + bit;
+                w[STATUS_WORD + (at / 32) as usize] ^= 1 << (at % 32);
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for IoSignal {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        IoSignal::all()
+            .find(|x| x.name() == s)
+            .ok_or_else(|| format!("unknown I/O signal {s:?}"))
+    }
+}
+
+fn status_bytes(w: &[u32]) -> Vec<u8> {
+    (0..STATUS_BITS / 8)
+        .map(|k| (w[STATUS_WORD + k / 4] >> (8 * (k % 4))) as u8)
+        .collect()
+}
+
+/// A clock's pins in the harness's layout.
+pub fn encode_inputs(i: &IoInputs) -> [u32; IN_WORDS] {
+    let mut w = [0u32; IN_WORDS];
+    let values = [
+        i.reset,
+        i.uart_rx,
+        i.enc_a,
+        i.enc_b,
+        i.enc_i,
+        i.limit_positive,
+        i.limit_negative,
+        i.emergency_stop,
+    ];
+    for (slot, v) in IN_SLOTS.iter().zip(values) {
+        slot.put(&mut w, u128::from(v));
+    }
+    w
+}
+
+/// A clock's outputs in the harness's layout.
+pub fn encode_outputs(o: &IoOutputs) -> [u32; OUT_WORDS] {
+    let mut w = [0u32; OUT_WORDS];
+    let pins = [
+        o.uart_tx,
+        o.pwm,
+        o.dir,
+        o.amplifier,
+        o.led_idle,
+        o.led_busy,
+        o.led_fault,
+        o.led_heartbeat,
+    ];
+    for (slot, v) in OUT_SLOTS.iter().zip(pins) {
+        slot.put(&mut w, u128::from(v));
+    }
+    for (k, b) in o.status.to_payload().into_iter().enumerate() {
+        w[STATUS_WORD + k / 4] |= u32::from(b) << (8 * (k % 4));
+    }
+    w
+}
+
+/// Decodes a clock's output words.
+pub fn decode_outputs(w: &[u32]) -> IoOutputs {
+    let pin = |k: usize| OUT_SLOTS[k].get(w) == 1;
+    IoOutputs {
+        uart_tx: pin(0),
+        pwm: pin(1),
+        dir: pin(2),
+        amplifier: pin(3),
+        led_idle: pin(4),
+        led_busy: pin(5),
+        led_fault: pin(6),
+        led_heartbeat: pin(7),
+        status: Status::from_payload(&status_bytes(w)).expect("the status block's length"),
+    }
+}
+
+type NewFn = unsafe extern "C" fn(*const c_char, u64, u64) -> *mut c_void;
+type FreeFn = unsafe extern "C" fn(*mut c_void);
+type RunFn = unsafe extern "C" fn(*mut c_void, u64, *const u32, *mut u32);
+type AbiFn = unsafe extern "C" fn() -> u32;
+
+/// One Verilated I/O top.
+pub struct FabricIo {
+    handle: *mut c_void,
+    free: FreeFn,
+    run: RunFn,
+    // Declared last: dropped after the instance is freed.
+    _lib: Library,
+}
+
+// The instance is only ever used from the thread that owns it.
+unsafe impl Send for FabricIo {}
+
+impl FabricIo {
+    /// Loads `library` and creates one I/O top; with `vcd`, the library must be a trace build.
+    pub fn open(library: &Path, vcd: Option<&VcdWindow>) -> Result<Self, SimError> {
+        let err = |reason: String| SimError::Load {
+            path: library.to_path_buf(),
+            reason,
+        };
+        // SAFETY: the library was built by `build_io` from our own io_harness.cpp; its symbols
+        // have the types declared above (checked through `snapgen_io_abi`).
+        unsafe {
+            let lib = Library::new(library).map_err(|e| err(e.to_string()))?;
+            let abi: AbiFn = *lib
+                .get::<AbiFn>(b"snapgen_io_abi\0")
+                .map_err(|e| err(e.to_string()))?;
+            let want = 0x20000 | ((IN_WORDS as u32) << 8) | OUT_WORDS as u32;
+            if abi() != want {
+                return Err(err(format!("harness ABI {:#x}, expected {want:#x}", abi())));
+            }
+            let new: NewFn = *lib
+                .get(b"snapgen_io_new\0")
+                .map_err(|e| err(e.to_string()))?;
+            let free: FreeFn = *lib
+                .get(b"snapgen_io_free\0")
+                .map_err(|e| err(e.to_string()))?;
+            let run: RunFn = *lib
+                .get(b"snapgen_io_run\0")
+                .map_err(|e| err(e.to_string()))?;
+            let (path, from, to) = match vcd {
+                Some(w) => (
+                    CString::new(w.path.to_string_lossy().as_bytes())
+                        .map_err(|_| err("VCD path contains a NUL byte".into()))?,
+                    w.from,
+                    w.to,
+                ),
+                None => (CString::default(), 0, 0),
+            };
+            let handle = new(path.as_ptr(), from, to);
+            Ok(FabricIo {
+                handle,
+                free,
+                run,
+                _lib: lib,
+            })
+        }
+    }
+
+    /// Runs one clock per entry of `ins`; `outs` receives `OUT_WORDS` words a clock.
+    pub fn run(&mut self, ins: &[[u32; IN_WORDS]], outs: &mut Vec<u32>) {
+        let n = ins.len();
+        outs.resize(n * OUT_WORDS, 0);
+        // SAFETY: `ins` holds n clocks of IN_WORDS words, contiguous; `outs` has room for n
+        // clocks of outputs.
+        unsafe {
+            (self.run)(
+                self.handle,
+                n as u64,
+                ins.as_ptr().cast::<u32>(),
+                outs.as_mut_ptr(),
+            )
+        }
+    }
+}
+
+impl Drop for FabricIo {
+    fn drop(&mut self) {
+        // SAFETY: the handle came from snapgen_io_new and is freed once.
+        unsafe { (self.free)(self.handle) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use snapgen_model::protocol::flag;
+
+    #[test]
+    fn outputs_round_trip_and_every_bit_is_a_signal() {
+        let o = IoOutputs {
+            uart_tx: true,
+            pwm: false,
+            dir: true,
+            amplifier: true,
+            led_idle: false,
+            led_busy: true,
+            led_fault: false,
+            led_heartbeat: true,
+            status: Status {
+                state: 5,
+                error: 3,
+                flags: flag::CUT | flag::AMPLIFIER,
+                tick_count: 0xDEAD_BEEF,
+                position: -7,
+                velocity: 123_456,
+                encoder: -99,
+                bad_crc: 0x1234,
+                bad_frames: 0xFFFF,
+                following_peak: 0x8765_4321,
+                duty: -1234,
+            },
+        };
+        let w = encode_outputs(&o);
+        assert_eq!(decode_outputs(&w), o);
+        // A flip of any used bit is seen by exactly one signal.
+        for word in 0..OUT_WORDS {
+            for bit in 0..32 {
+                let mut bad = w;
+                bad[word] ^= 1 << bit;
+                let seen: Vec<IoSignal> = IoSignal::all()
+                    .filter(|s| s.value(&bad) != s.value(&w))
+                    .collect();
+                let used = OUT_SLOTS.iter().any(|s| s.covers(word, bit));
+                assert_eq!(seen.len(), usize::from(used), "word {word} bit {bit}");
+            }
+        }
+        // flip() flips what value() reads.
+        for s in IoSignal::all() {
+            let mut bad = w;
+            s.flip(&mut bad, 3);
+            assert_ne!(s.value(&bad), s.value(&w), "{}", s.name());
+        }
+    }
+}

@@ -1,0 +1,932 @@
+//! Lockstep co-simulation of the Verilated I/O top against the device model
+//! (`snapgen_model::device::Device`), clock by clock: both get the same pins on every clock and
+//! every output — `uart_tx`, PWM, direction, amplifier enable, the LEDs and every field of the
+//! status block — is compared after every rising edge.
+//!
+//! The pins come from a host, an encoder and switches ([`snapgen_model::peer::Peer`]) driven
+//! by a random command stream: commands of every kind with good and bad arguments, back to
+//! back and in bursts past the reply queue, retries with the same and with another payload,
+//! bit errors, frames cut short, over-long lengths, noise, line breaks, real moves uploaded and
+//! started, stops and halts at random ticks (mid-jerk, mid-acceleration), limit switches,
+//! the emergency stop, watchdog expiry, telemetry at short periods and configuration changes.
+//! The peer reacts to the model's outputs (which must equal the fabric's on every clock), so
+//! the stream is computed a batch ahead and the fabric then runs the batch.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::Instant;
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
+use snapgen_model::format::Quantity;
+use snapgen_model::peer::Peer;
+use snapgen_model::protocol::{
+    code, flag, AxisState, Command, Decoded, Decoder, ErrorId, Frame, Param, Reason, Reply, Status,
+    DEVICE_MAX_PAYLOAD, START,
+};
+use snapgen_model::timing::Dividers;
+use snapgen_model::{plan_from, Format, Method, MoveRequest, Segment, DEFAULT_FORMAT};
+
+use crate::build::build_io;
+use crate::fabric::VcdWindow;
+use crate::io::{encode_inputs, encode_outputs, FabricIo, IoSignal, IN_WORDS, OUT_WORDS};
+use crate::SimError;
+
+/// Clocks per batch: the stream and the model run a batch ahead, then the fabric runs it.
+const BATCH: usize = 1 << 10;
+
+/// The design the co-simulation uses: a 1 MHz clock, 8 clocks per UART bit (125 000 baud), a
+/// tick every 16 clocks, a 2 ms frame timeout — small numbers, so that a million clocks hold
+/// hundreds of frames, moves and stops. (The stop unit decides a stopping tick in more clocks
+/// than 16, so stopping ticks wait for it here, which is exercised too.)
+pub fn cosim_design() -> Design {
+    let d = Design {
+        format: DEFAULT_FORMAT,
+        dividers: Dividers {
+            uart_divisor: 8,
+            tick_div: 15,
+            frame_timeout: 2000,
+            heartbeat_bit: 10,
+            clocks_per_ms: 1000,
+        },
+        clock_hz: 1_000_000,
+        baud: 125_000,
+        design_hash: 0,
+        // Limit+ and the emergency stop normally closed: the reset value is exercised.
+        input_polarity: 5,
+    };
+    snapgen_hdl::verilog::io_design(&d)
+}
+
+/// A deliberate error in the captured fabric outputs, to prove the comparison fails.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IoFault {
+    /// Clock at which to flip.
+    pub clock: u64,
+    /// Signal to flip.
+    pub signal: IoSignal,
+    /// Bit (modulo its width).
+    pub bit: u32,
+}
+
+/// The first difference between fabric and model.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IoMismatch {
+    /// Session that found it.
+    pub session: usize,
+    /// Clock (rising edges since power-up, from 0).
+    pub clock: u64,
+    /// Signal that differs.
+    pub signal: IoSignal,
+    /// Model's value.
+    pub expected: u128,
+    /// Fabric's value.
+    pub actual: u128,
+}
+
+impl std::fmt::Display for IoMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "first I/O mismatch in session {} at clock {}: {} expected {:#x} got {:#x}",
+            self.session,
+            self.clock,
+            self.signal.name(),
+            self.expected,
+            self.actual
+        )
+    }
+}
+
+/// Settings of an I/O co-simulation.
+#[derive(Clone, Debug)]
+pub struct IoCosimConfig {
+    /// Clocks per session.
+    pub clocks: u64,
+    /// Seed of session 0 (the others derive theirs from it).
+    pub seed: u64,
+    /// Sessions (each its own I/O top, model and stream), run on one thread per core.
+    pub sessions: usize,
+    /// A deliberate fault (tests); it goes to session 0.
+    pub fault: Option<IoFault>,
+    /// Where to write the waves around a mismatch.
+    pub mismatch_vcd: PathBuf,
+}
+
+impl IoCosimConfig {
+    /// `clocks` clocks in each of `sessions` sessions from `seed`.
+    pub fn new(clocks: u64, seed: u64, sessions: usize) -> Self {
+        IoCosimConfig {
+            clocks,
+            seed,
+            sessions: sessions.max(1),
+            fault: None,
+            mismatch_vcd: PathBuf::from("io-mismatch.vcd"),
+        }
+    }
+
+    fn session_seed(&self, s: usize) -> u64 {
+        if s == 0 {
+            self.seed
+        } else {
+            self.seed ^ (s as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        }
+    }
+}
+
+/// What the streams did (counted from what the host received and the status it saw), so a
+/// test can check that every path was exercised.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IoCosimReport {
+    /// Clocks compared.
+    pub clocks: u64,
+    /// Frames the host sent whole and well-formed.
+    pub frames_sent: u64,
+    /// Frames sent with a bit error, cut short, with an over-long length, or noise bursts.
+    pub damaged_sent: u64,
+    /// Replies and telemetry frames the host received, by code (ACK, NAK, …).
+    pub replies: Vec<(u8, u64)>,
+    /// NAKs by reason byte.
+    pub naks: Vec<(u8, u64)>,
+    /// NAKs of a command for a reason the refusal table (`protocol::REFUSALS`,
+    /// docs/PROTOCOL.md) does not list for it: (command, reason).
+    pub undocumented: Vec<(u8, u8)>,
+    /// Moves uploaded and started (START acknowledged).
+    pub moves_started: u64,
+    /// STOP and HALT commands acknowledged.
+    pub stops_acked: u64,
+    /// Clocks with a controlled stop running.
+    pub stopping_clocks: u64,
+    /// Entries into ErrorStop, by error identifier byte.
+    pub errors: Vec<(u8, u64)>,
+    /// Clocks with the reply-overflow flag set.
+    pub overflow_clocks: u64,
+    /// Seconds of wall time.
+    pub seconds: f64,
+    /// The first mismatch.
+    pub mismatch: Option<IoMismatch>,
+    /// Waves written around it.
+    pub vcd: Option<PathBuf>,
+}
+
+impl IoCosimReport {
+    fn bump(list: &mut Vec<(u8, u64)>, key: u8) {
+        match list.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, n)) => *n += 1,
+            None => {
+                list.push((key, 1));
+                list.sort_unstable();
+            }
+        }
+    }
+
+    /// How many of `key` in `list`.
+    pub fn count(list: &[(u8, u64)], key: u8) -> u64 {
+        list.iter().find(|(k, _)| *k == key).map_or(0, |(_, n)| *n)
+    }
+
+    fn merge(&mut self, o: &IoCosimReport) {
+        self.clocks += o.clocks;
+        self.frames_sent += o.frames_sent;
+        self.damaged_sent += o.damaged_sent;
+        self.moves_started += o.moves_started;
+        self.stops_acked += o.stops_acked;
+        self.stopping_clocks += o.stopping_clocks;
+        self.overflow_clocks += o.overflow_clocks;
+        for (dst, src) in [
+            (&mut self.replies, &o.replies),
+            (&mut self.naks, &o.naks),
+            (&mut self.errors, &o.errors),
+        ] {
+            for &(k, n) in src {
+                for _ in 0..n {
+                    Self::bump(dst, k);
+                }
+            }
+        }
+        for p in &o.undocumented {
+            if !self.undocumented.contains(p) {
+                self.undocumented.push(*p);
+            }
+        }
+    }
+
+    /// Clocks per second of wall time.
+    pub fn clocks_per_second(&self) -> f64 {
+        self.clocks as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// The random host: what it sends and does, clock by clock.
+struct Stream {
+    rng: StdRng,
+    design: Design,
+    /// Clocks to wait before the next action.
+    wait: u64,
+    seq: u8,
+    last_frame: Option<Frame>,
+    /// A line break in progress: clocks left.
+    breaking: u64,
+    decoder: Decoder,
+    report: IoCosimReport,
+    last_state: u8,
+    /// Sequence numbers of START, STOP and HALT frames sent, to count their ACKs.
+    pending: VecDeque<(u8, u8)>,
+    /// Clocks since the stream began.
+    now: u64,
+    /// A command to send at a clock (a stop or halt in the middle of a move).
+    scheduled: Option<(u64, Command)>,
+    /// When the emergency stop and the limit switches go back to rest (they are pulses).
+    release: [Option<u64>; 3],
+}
+
+fn log_uniform(r: &mut StdRng, lo: f64, hi: f64) -> f64 {
+    r.gen_range(lo.ln()..=hi.ln()).exp()
+}
+
+impl Stream {
+    fn new(seed: u64, design: Design) -> Self {
+        Stream {
+            rng: StdRng::seed_from_u64(seed),
+            design,
+            wait: 50,
+            seq: 0,
+            last_frame: None,
+            breaking: 0,
+            decoder: Decoder::new(),
+            report: IoCosimReport::default(),
+            last_state: 0,
+            pending: VecDeque::new(),
+            now: 0,
+            scheduled: None,
+            release: [None; 3],
+        }
+    }
+
+    fn next_seq(&mut self) -> u8 {
+        self.seq = self.seq.wrapping_add(1).max(1);
+        self.seq
+    }
+
+    /// Sends command `c` as a good frame.
+    fn send(&mut self, peer: &mut Peer, c: Command) {
+        let seq = self.next_seq();
+        let f = c.to_frame(seq, &self.design.format);
+        if matches!(c, Command::Start | Command::Stop | Command::Halt) {
+            self.pending.push_back((seq, c.code()));
+        }
+        peer.send(&f.to_bytes());
+        self.report.frames_sent += 1;
+        self.last_frame = Some(f);
+    }
+
+    /// A random configuration write, mostly sensible values.
+    fn configure(&mut self, peer: &mut Peer) {
+        let r = &mut self.rng;
+        let gain = |r: &mut StdRng| -> i128 {
+            match r.gen_range(0..4) {
+                0 => 0,
+                1 => (1i128 << snapgen_model::io::servo::GAIN_BITS) - 1,
+                _ => log_uniform(r, 1.0, 1.4e14) as i128,
+            }
+        };
+        let (param, value) = match r.gen_range(0..16) {
+            // The controller: its rate and following limit (Disabled only), gains, limits.
+            10 => (Param::ServoPeriod, [0, 1, 1, 2, 5][r.gen_range(0..5)]),
+            11 => (
+                Param::FollowingLimit,
+                [0, 1, 3, 50, 100_000][r.gen_range(0..5)],
+            ),
+            12 => (
+                [Param::Kp, Param::Ki, Param::Kd, Param::Kv, Param::Ka][r.gen_range(0..5)],
+                gain(r),
+            ),
+            13 => (Param::IntegralLimit, gain(r)),
+            14 => (Param::OutputLimit, [0, 10, 150, 32767][r.gen_range(0..4)]),
+            15 => (Param::Kp, gain(r)),
+            0 => (Param::TelemetryPeriod, r.gen_range(0..60)),
+            1 => (Param::WatchdogMs, [0, 1, 3, 10, 1000][r.gen_range(0..5)]),
+            2 | 3 => {
+                let s = stop_limits(r);
+                return self.send_configs(peer, &[(Param::StopJerk, s.0), (Param::StopAccel, s.1)]);
+            }
+            // Any polarity of the limits (a wrong one reads a switch as active); the emergency
+            // stop's bit kept as wired (a wrong one latches ErrorStop until the reset pin).
+            4 => (
+                Param::InputPolarity,
+                r.gen_range(0..4) | i128::from(self.design.input_polarity & 4),
+            ),
+            5 => (Param::InputFilter, r.gen_range(0..20)),
+            6 => (Param::PwmPeriod, r.gen_range(0..200)),
+            7 => (Param::EncoderFilter, r.gen_range(0..4)),
+            8 => (Param::TickDivider, [15, 15, 7, 40, 200][r.gen_range(0..5)]),
+            // Out of range (BAD_ARGUMENT).
+            _ => (Param::InputPolarity, 8 + r.gen_range(0..100)),
+        };
+        self.send(peer, Command::Configure { param, value });
+    }
+
+    fn send_configs(&mut self, peer: &mut Peer, list: &[(Param, i128)]) {
+        for &(param, value) in list {
+            self.send(peer, Command::Configure { param, value });
+        }
+    }
+
+    /// A move from where the model stands, uploaded and started (the device decides whether
+    /// it accepts it).
+    fn upload_move(&mut self, peer: &mut Peer, dev: &Device) {
+        let r = &mut self.rng;
+        let ts = [1e-3, 1e-4][r.gen_range(0..2)];
+        let f = Format::with_ts(ts);
+        let distance = log_uniform(r, 1e-6, 2e-2) * if r.gen_bool(0.5) { 1.0 } else { -1.0 };
+        let v = log_uniform(r, 0.01, 2.0);
+        let a = log_uniform(r, 0.5, 200.0);
+        let method = match r.gen_range(0..3) {
+            0 => Method::Order2 { vmax: v, amax: a },
+            1 => Method::Order3 {
+                vmax: v,
+                amax: a,
+                jmax: log_uniform(r, 5.0, 1e5),
+            },
+            _ => Method::Order4 {
+                vmax: v,
+                amax: a,
+                jmax: log_uniform(r, 5.0, 1e5),
+                dmax: log_uniform(r, 1e3, 1e8),
+            },
+        };
+        let req = MoveRequest { distance, method };
+        let Ok(plan) = plan_from(&req, &f, dev.core().chain()) else {
+            return;
+        };
+        if plan.ticks_total() > 4000 || plan.program.segments.is_empty() {
+            return;
+        }
+        for (k, s) in plan.program.segments.iter().enumerate() {
+            self.send(
+                peer,
+                Command::LoadSegment {
+                    index: k as u8,
+                    segment: *s,
+                },
+            );
+        }
+        let count = plan.program.segments.len() as u8;
+        self.send(peer, Command::Commit { count });
+        self.send(peer, Command::Start);
+        if self.rng.gen_bool(0.2) {
+            // Again: the program was consumed (NO_PROGRAM), or it plays (BUSY).
+            self.send(peer, Command::Start);
+        }
+        // Half of the moves get a stop or a halt at a random clock of their run.
+        if self.rng.gen_bool(0.5) {
+            let run = plan.ticks_total() * (u64::from(self.design.dividers.tick_div) + 1);
+            let upload = 12 * u64::from(self.design.dividers.uart_divisor) * 30;
+            let at = self.now + upload + log_uniform(&mut self.rng, 10.0, run as f64 + 10.0) as u64;
+            let c = if self.rng.gen_bool(0.7) {
+                Command::Stop
+            } else {
+                Command::Halt
+            };
+            self.scheduled = Some((at, c));
+        }
+    }
+
+    /// Bytes of a damaged frame, or noise.
+    fn damaged(&mut self, peer: &mut Peer) {
+        let r = &mut self.rng;
+        let c = random_command(r, &self.design.format);
+        let seq = self.seq.wrapping_add(1).max(1);
+        self.seq = seq;
+        let mut bytes = c.to_frame(seq, &self.design.format).to_bytes();
+        match r.gen_range(0..7) {
+            5 => {
+                // A good CRC on an unknown command.
+                let cmd = loop {
+                    let c = r.gen::<u8>();
+                    if snapgen_model::protocol::command_spec(c).is_none() {
+                        break c;
+                    }
+                };
+                let n = r.gen_range(0..4);
+                let payload = (0..n).map(|_| r.gen::<u8>()).collect();
+                bytes = Frame { cmd, seq, payload }.to_bytes();
+            }
+            6 => {
+                // A good CRC on a known command with the wrong length.
+                let mut f = c.to_frame(seq, &self.design.format);
+                if f.payload.is_empty() || r.gen_bool(0.5) {
+                    f.payload.push(r.gen());
+                } else {
+                    f.payload.pop();
+                }
+                bytes = f.to_bytes();
+            }
+            0 => {
+                // One bit flipped anywhere.
+                let k = r.gen_range(0..bytes.len());
+                bytes[k] ^= 1 << r.gen_range(0..8);
+            }
+            1 => {
+                // Cut short: the rest never comes (the receiver times out).
+                bytes.truncate(r.gen_range(1..bytes.len()));
+                self.wait = u64::from(self.design.dividers.frame_timeout)
+                    + 200 * u64::from(self.design.dividers.uart_divisor);
+            }
+            2 => {
+                // An over-long length.
+                bytes = vec![START, r.gen_range(DEVICE_MAX_PAYLOAD as u8 + 1..=255)];
+                bytes.extend((0..r.gen_range(0..40)).map(|_| r.gen::<u8>()));
+            }
+            3 => {
+                // Noise.
+                bytes = (0..r.gen_range(1..30)).map(|_| r.gen::<u8>()).collect();
+            }
+            _ => {
+                // A good frame whose length byte lies (within the device's maximum).
+                bytes[1] = r.gen_range(0..=DEVICE_MAX_PAYLOAD as u8);
+            }
+        }
+        peer.send(&bytes);
+        self.report.damaged_sent += 1;
+    }
+
+    /// The next action, when the last one's wait is over.
+    fn act(&mut self, peer: &mut Peer, dev: &Device) {
+        let r = &mut self.rng;
+        let choice = r.gen_range(0..100);
+        let st = dev.status();
+        match choice {
+            // Get the axis going: stop limits, power, a move.
+            0..=14 => {
+                if st.state == AxisState::ErrorStop as u8 {
+                    self.send(peer, Command::Reset);
+                } else if st.state == AxisState::Disabled as u8 || !st.has(flag::AMPLIFIER) {
+                    let s = stop_limits(&mut self.rng);
+                    self.send_configs(peer, &[(Param::StopJerk, s.0), (Param::StopAccel, s.1)]);
+                    // Mostly with the controller off again (a stalled-motor test left it on).
+                    if self.rng.gen_bool(0.7) {
+                        self.send(
+                            peer,
+                            Command::Configure {
+                                param: Param::ServoPeriod,
+                                value: 0,
+                            },
+                        );
+                    }
+                    self.send(peer, Command::Power { on: true });
+                } else {
+                    self.upload_move(peer, dev);
+                }
+            }
+            15..=29 => self.upload_move(peer, dev),
+            30..=37 => {
+                let c = if r.gen_bool(0.6) {
+                    Command::Stop
+                } else {
+                    Command::Halt
+                };
+                self.send(peer, c);
+            }
+            38..=49 => {
+                let c = random_command(r, &self.design.format);
+                self.send(peer, c);
+            }
+            50..=54 => {
+                // A burst of reads, sometimes past the reply queue.
+                let n = r.gen_range(2..24);
+                for _ in 0..n {
+                    let c = [
+                        Command::ReadStatus,
+                        Command::Ping,
+                        Command::ReadState,
+                        Command::ReadConfig {
+                            param: Param::StopJerk,
+                        },
+                    ][self.rng.gen_range(0..4)];
+                    self.send(peer, c);
+                }
+            }
+            55..=59 => {
+                // A retry: the same frame again (answered again, not executed again), or the
+                // same sequence with another payload (executed).
+                if let Some(mut f) = self.last_frame.clone() {
+                    if r.gen_bool(0.3) && !f.payload.is_empty() {
+                        let k = r.gen_range(0..f.payload.len());
+                        f.payload[k] ^= 1;
+                    }
+                    peer.send(&f.to_bytes());
+                    self.report.frames_sent += 1;
+                }
+            }
+            60..=69 => self.damaged(peer),
+            70..=77 => self.configure(peer),
+            78..=80 => {
+                // A line break: the receiver sees a framing error.
+                self.breaking = u64::from(self.design.dividers.uart_divisor) * r.gen_range(10..40);
+            }
+            // The switches as pulses of random length.
+            81..=84 => {
+                peer.limit_positive = true;
+                self.release[0] = Some(self.now + log_uniform(r, 10.0, 30_000.0) as u64);
+            }
+            85..=88 => {
+                peer.limit_negative = true;
+                self.release[1] = Some(self.now + log_uniform(r, 10.0, 30_000.0) as u64);
+            }
+            89 => {
+                peer.emergency_stop = true;
+                self.release[2] = Some(self.now + log_uniform(r, 10.0, 20_000.0) as u64);
+            }
+            90..=91 => self.send(peer, Command::Reset),
+            92 => {
+                let on = r.gen_bool(0.3);
+                self.send(peer, Command::Power { on });
+            }
+            93 => peer.follow = !peer.follow,
+            // The reset pin, now and then (everything restarts; the queue and flags clear).
+            94 if r.gen_bool(0.2) => peer.reset_clocks = r.gen_range(1..4),
+            // A watchdog that expires while a move runs: a short watchdog, a move, silence.
+            95..=96 => {
+                let ms = r.gen_range(1..4);
+                self.send(
+                    peer,
+                    Command::Configure {
+                        param: Param::WatchdogMs,
+                        value: ms,
+                    },
+                );
+                self.upload_move(peer, dev);
+                self.scheduled = None;
+                self.wait = 30_000;
+            }
+            // A stalled motor: the controller on with a small following limit, a move with
+            // the encoder held (the following-error fault), or the motor free again.
+            97..=98 => {
+                if st.state == AxisState::Disabled as u8 {
+                    let s = stop_limits(r);
+                    let configs = [
+                        (Param::ServoPeriod, [1, 2][r.gen_range(0..2)]),
+                        (Param::FollowingLimit, [1, 2, 5][r.gen_range(0..3)]),
+                        (Param::Kp, 50i128 << 32),
+                        (Param::PwmPeriod, 100),
+                        (Param::StopJerk, s.0),
+                        (Param::StopAccel, s.1),
+                    ];
+                    self.send_configs(peer, &configs);
+                    self.send(peer, Command::Power { on: true });
+                    peer.follow = false;
+                    // A long move of constant snap: the error passes the limit early.
+                    self.send(
+                        peer,
+                        Command::LoadSegment {
+                            index: 0,
+                            segment: Segment {
+                                ticks: 100_000,
+                                snap: 1 << 40,
+                            },
+                        },
+                    );
+                    self.send(peer, Command::Commit { count: 1 });
+                    self.send(peer, Command::Start);
+                } else {
+                    peer.follow = true;
+                    self.send(peer, Command::Power { on: false });
+                }
+            }
+            // Idle: telemetry, watchdog expiry, moves running to their end.
+            _ => self.wait = log_uniform(r, 100.0, 60_000.0) as u64,
+        }
+        if self.wait == 0 {
+            self.wait = match self.rng.gen_range(0..10) {
+                0..=3 => 0,
+                4..=7 => self.rng.gen_range(1..300),
+                _ => log_uniform(&mut self.rng, 300.0, 20_000.0) as u64,
+            };
+        }
+    }
+
+    /// The pins for the next clock.
+    fn inputs(&mut self, peer: &mut Peer, dev: &Device) -> IoInputs {
+        self.now += 1;
+        if let Some((at, c)) = self.scheduled {
+            if at <= self.now {
+                self.scheduled = None;
+                self.send(peer, c);
+            }
+        }
+        for (k, at) in self.release.iter_mut().enumerate() {
+            if at.is_some_and(|t| t <= self.now) {
+                *at = None;
+                match k {
+                    0 => peer.limit_positive = false,
+                    1 => peer.limit_negative = false,
+                    _ => peer.emergency_stop = false,
+                }
+            }
+        }
+        if self.wait > 0 {
+            self.wait -= 1;
+        } else if !peer.sending() && self.breaking == 0 {
+            self.act(peer, dev);
+        }
+        peer.line_break = self.breaking > 0;
+        self.breaking = self.breaking.saturating_sub(1);
+        peer.inputs()
+    }
+
+    /// What the host saw after a clock.
+    fn observe(&mut self, peer: &mut Peer, o: &IoOutputs) {
+        peer.observe(o);
+        let st: Status = o.status;
+        if st.has(flag::STOPPING) {
+            self.report.stopping_clocks += 1;
+        }
+        if st.has(flag::REPLY_OVERFLOW) {
+            self.report.overflow_clocks += 1;
+        }
+        if st.state == AxisState::ErrorStop as u8 && self.last_state != st.state {
+            IoCosimReport::bump(&mut self.report.errors, st.error);
+            // The stalled motor is free again once the fault has stopped it.
+            if st.error == ErrorId::FollowingError as u8 {
+                peer.follow = true;
+            }
+        }
+        self.last_state = st.state;
+        for b in peer.take_received() {
+            if let Some(Decoded::Frame(f)) = self.decoder.push(b) {
+                IoCosimReport::bump(&mut self.report.replies, f.cmd);
+                match Reply::from_frame(&f) {
+                    Some(Reply::Nak { cmd, reason }) => {
+                        IoCosimReport::bump(&mut self.report.naks, reason as u8);
+                        let frame_level = matches!(
+                            reason,
+                            Reason::BadCrc
+                                | Reason::Framing
+                                | Reason::BadLength
+                                | Reason::UnknownCommand
+                        );
+                        if !frame_level
+                            && !snapgen_model::protocol::refusal_documented(cmd, reason)
+                            && !self.report.undocumented.contains(&(cmd, reason as u8))
+                        {
+                            self.report.undocumented.push((cmd, reason as u8));
+                        }
+                    }
+                    Some(Reply::Ack { cmd }) => {
+                        if let Some(k) = self.pending.iter().position(|&(s, _)| s == f.seq) {
+                            self.pending.remove(k);
+                            if cmd == code::START {
+                                self.report.moves_started += 1;
+                            } else {
+                                self.report.stops_acked += 1;
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        while self.pending.len() > 64 {
+            self.pending.pop_front();
+        }
+    }
+}
+
+/// Stop limits (jerk, acceleration), raw, for moves like the stream's (planned at Ts = 1 ms):
+/// mostly valid, now and then invalid (jerk above acceleration, or zero: POWER is then
+/// refused).
+fn stop_limits(r: &mut StdRng) -> (i128, i128) {
+    let g = Format::with_ts(1e-3);
+    let accel = (log_uniform(r, 0.5, 500.0) * g.scale(Quantity::Acceleration)) as i128;
+    let jerk = (log_uniform(r, 5.0, 1e5) * g.scale(Quantity::Jerk)) as i128;
+    match r.gen_range(0..20) {
+        0 => (0, accel.max(1)),
+        1 => (accel.max(1) + 1, accel.max(1)),
+        _ => (jerk.clamp(1, accel.max(1)), accel.max(1)),
+    }
+}
+
+/// Any command with random arguments (good and bad).
+fn random_command(r: &mut StdRng, f: &Format) -> Command {
+    let n = snapgen_model::protocol::PARAMS.len() as u8;
+    let param = Param::from_byte(r.gen_range(1..=n)).expect("1..=n are parameters");
+    match r.gen_range(0..12) {
+        0 => Command::Ping,
+        1 => Command::LoadSegment {
+            index: r.gen_range(0..f.max_segments as u8),
+            segment: Segment {
+                ticks: r.gen_range(1..50),
+                snap: r.gen_range(-(1i128 << 60)..(1i128 << 60)),
+            },
+        },
+        2 => Command::Commit {
+            count: r.gen_range(0..=f.max_segments as u8),
+        },
+        3 => Command::Start,
+        4 => Command::Stop,
+        5 => Command::Halt,
+        6 => Command::ReadStatus,
+        7 => Command::ReadState,
+        8 => Command::ReadConfig { param },
+        9 => Command::Power {
+            on: r.gen_bool(0.5),
+        },
+        10 => Command::Reset,
+        // (INPUT_POLARITY is written by `Stream::configure`, which keeps the emergency stop's
+        // bit as wired.)
+        _ => Command::Configure {
+            param: if param == Param::InputPolarity {
+                Param::InputFilter
+            } else {
+                param
+            },
+            value: r.gen_range(0..100),
+        },
+    }
+}
+
+/// One session: the stream, the model and (unless `None`) the fabric in lockstep.
+fn session(
+    design: &Design,
+    seed: u64,
+    clocks: u64,
+    mut fabric: Option<FabricIo>,
+    fault: Option<IoFault>,
+    index: usize,
+) -> IoCosimReport {
+    let mut dev = Device::new(design);
+    let mut peer = Peer::new(design.dividers.uart_divisor);
+    peer.wiring = design.input_polarity;
+    let mut stream = Stream::new(seed, *design);
+    let mut ins: Vec<[u32; IN_WORDS]> = Vec::with_capacity(BATCH);
+    let mut want: Vec<[u32; OUT_WORDS]> = Vec::with_capacity(BATCH);
+    let mut got: Vec<u32> = Vec::new();
+    let start = Instant::now();
+    let mut clock = 0u64;
+    while clock < clocks {
+        let n = (clocks - clock).min(BATCH as u64) as usize;
+        ins.clear();
+        want.clear();
+        for _ in 0..n {
+            let i = stream.inputs(&mut peer, &dev);
+            ins.push(encode_inputs(&i));
+            let o = dev.clock(&i);
+            stream.observe(&mut peer, &o);
+            want.push(encode_outputs(&o));
+        }
+        if let Some(fab) = fabric.as_mut() {
+            fab.run(&ins, &mut got);
+            for (k, w) in want.iter().enumerate() {
+                let words = &mut got[k * OUT_WORDS..(k + 1) * OUT_WORDS];
+                let at = clock + k as u64;
+                if let Some(fl) = fault.filter(|fl| fl.clock == at) {
+                    fl.signal.flip(words, fl.bit);
+                }
+                if words != w {
+                    let signal = IoSignal::all()
+                        .find(|s| s.value(words) != s.value(w))
+                        .expect("every output bit belongs to a signal (tested)");
+                    stream.report.clocks = at;
+                    stream.report.seconds = start.elapsed().as_secs_f64();
+                    stream.report.mismatch = Some(IoMismatch {
+                        session: index,
+                        clock: at,
+                        signal,
+                        expected: signal.value(w),
+                        actual: signal.value(words),
+                    });
+                    return stream.report;
+                }
+            }
+        }
+        clock += n as u64;
+    }
+    stream.report.clocks = clock;
+    stream.report.seconds = start.elapsed().as_secs_f64();
+    stream.report
+}
+
+/// Runs the I/O co-simulation of `design` (its I/O top's Verilog generated here): its
+/// sessions on one worker thread per core; on a mismatch, the session is run again with a
+/// trace build and the waves around it are written.
+pub fn run(design: &Design, cfg: &IoCosimConfig) -> Result<IoCosimReport, SimError> {
+    let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+    let built = build_io(&verilog, false)?;
+    let mut queue: VecDeque<(usize, FabricIo)> = VecDeque::new();
+    for s in 0..cfg.sessions {
+        queue.push_back((s, FabricIo::open(&built.library, None)?));
+    }
+    let queue = Mutex::new(queue);
+    let outcomes: Mutex<Vec<Option<IoCosimReport>>> = Mutex::new(vec![None; cfg.sessions]);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(cfg.sessions);
+    let wall = Instant::now();
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let next = queue.lock().unwrap_or_else(|e| e.into_inner()).pop_front();
+                let Some((s, fab)) = next else { break };
+                let fault = if s == 0 { cfg.fault } else { None };
+                let r = session(design, cfg.session_seed(s), cfg.clocks, Some(fab), fault, s);
+                outcomes.lock().unwrap_or_else(|e| e.into_inner())[s] = Some(r);
+            });
+        }
+    });
+    let mut report = IoCosimReport::default();
+    let outcomes = outcomes.into_inner().unwrap_or_else(|e| e.into_inner());
+    for r in outcomes.iter().flatten() {
+        report.merge(r);
+        if report.mismatch.is_none() {
+            report.mismatch = r.mismatch.clone();
+        }
+    }
+    report.seconds = wall.elapsed().as_secs_f64();
+    if let (Some(fault), Some(r0)) = (cfg.fault, outcomes.first().and_then(|o| o.as_ref())) {
+        if r0.mismatch.is_none() {
+            return Err(SimError::FaultNotReached {
+                clock: fault.clock,
+                clocks: r0.clocks,
+            });
+        }
+    }
+    if let Some(m) = report.mismatch.clone() {
+        let traced = build_io(&verilog, true)?;
+        let w = VcdWindow {
+            path: cfg.mismatch_vcd.clone(),
+            from: m.clock.saturating_sub(2000),
+            to: m.clock + 16,
+        };
+        let fab = FabricIo::open(&traced.library, Some(&w))?;
+        let fault = if m.session == 0 { cfg.fault } else { None };
+        let _ = session(
+            design,
+            cfg.session_seed(m.session),
+            m.clock + 1,
+            Some(fab),
+            fault,
+            m.session,
+        );
+        report.vcd = Some(cfg.mismatch_vcd.clone());
+    }
+    Ok(report)
+}
+
+/// The same sessions on the model alone (the reference for the speed ratio).
+pub fn run_model_only(design: &Design, cfg: &IoCosimConfig) -> IoCosimReport {
+    let mut report = IoCosimReport::default();
+    let wall = Instant::now();
+    for s in 0..cfg.sessions {
+        let r = session(design, cfg.session_seed(s), cfg.clocks, None, None, s);
+        report.merge(&r);
+    }
+    report.seconds = wall.elapsed().as_secs_f64();
+    report
+}
+
+/// Names of the NAK reasons and error identifiers a report counts (for printing).
+pub fn describe(r: &IoCosimReport) -> String {
+    let naks: Vec<String> = r
+        .naks
+        .iter()
+        .map(|&(k, n)| {
+            format!(
+                "{} {n}",
+                Reason::from_byte(k).map_or("?".into(), |x| x.name().to_string())
+            )
+        })
+        .collect();
+    let errors: Vec<String> = r
+        .errors
+        .iter()
+        .map(|&(k, n)| {
+            format!(
+                "{} {n}",
+                ErrorId::from_byte(k).map_or("?".into(), |x| x.name().to_string())
+            )
+        })
+        .collect();
+    let count = |c: u8| IoCosimReport::count(&r.replies, c);
+    format!(
+        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
+        r.clocks,
+        r.frames_sent,
+        r.damaged_sent,
+        count(code::ACK),
+        count(code::NAK),
+        naks.join(", "),
+        count(code::STATUS),
+        count(code::STATE),
+        count(code::IDENTITY),
+        count(code::CONFIG),
+        count(code::TELEMETRY),
+        r.moves_started,
+        r.stops_acked,
+        r.stopping_clocks,
+        if errors.is_empty() { "none".into() } else { errors.join(", ") },
+        r.overflow_clocks,
+    )
+}

@@ -1,0 +1,313 @@
+//! Word layouts between the Rust side of a co-simulation and its C++ harness: one table of a
+//! design's ports (name, width) is the single source of the harness's C++ (generated into the
+//! build as `snapgen_layout.h`), the wrapper's Verilog ports and the Rust encoders and
+//! decoders.
+//!
+//! Ports wider than 32 bits take whole 32-bit words of their own (low word first); narrower
+//! ones are packed, in table order, into shared words from bit 0 up. [`Slot::get`] and
+//! [`Slot::put`] handle ports of up to 128 bits; wider ones are read word by word.
+
+/// A port of the design under test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Port {
+    /// Its Verilog name (and the Verilated C++ member's).
+    pub name: &'static str,
+    /// Its width.
+    pub bits: u32,
+}
+
+/// Where a port's bits are in the word array.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Slot {
+    /// First word.
+    pub word: usize,
+    /// Bit offset within it (0 for wide ports).
+    pub shift: u32,
+    /// Width.
+    pub bits: u32,
+}
+
+impl Slot {
+    /// Mask of a narrow port within its word (shifted down).
+    pub const fn mask(&self) -> u32 {
+        if self.bits >= 32 {
+            u32::MAX
+        } else {
+            (1 << self.bits) - 1
+        }
+    }
+
+    /// Words it takes.
+    pub const fn words(&self) -> usize {
+        if self.bits > 32 {
+            self.bits.div_ceil(32) as usize
+        } else {
+            1
+        }
+    }
+
+    /// True when bit `bit` of word `word` is one of its bits.
+    pub const fn covers(&self, word: usize, bit: u32) -> bool {
+        if word < self.word || word >= self.word + self.words() {
+            return false;
+        }
+        let index = (word - self.word) as u32 * 32 + bit;
+        index >= self.shift && index < self.shift + self.bits
+    }
+
+    /// Its value in `w` (ports of at most 128 bits).
+    #[inline(always)]
+    pub fn get(&self, w: &[u32]) -> u128 {
+        debug_assert!(self.bits <= 128, "get: a port wider than 128 bits");
+        if self.bits <= 32 {
+            u128::from((w[self.word] >> self.shift) & self.mask())
+        } else {
+            let mut v = 0u128;
+            for k in 0..self.words() {
+                v |= u128::from(w[self.word + k]) << (32 * k);
+            }
+            v & (u128::MAX >> (128 - self.bits))
+        }
+    }
+
+    /// Writes `v` (its low `bits` bits) into `w` (ports of at most 128 bits).
+    #[inline(always)]
+    pub fn put(&self, w: &mut [u32], v: u128) {
+        debug_assert!(self.bits <= 128, "put: a port wider than 128 bits");
+        if self.bits <= 32 {
+            let m = self.mask() << self.shift;
+            w[self.word] = (w[self.word] & !m) | (((v as u32) << self.shift) & m);
+        } else {
+            let v = v & (u128::MAX >> (128 - self.bits));
+            for k in 0..self.words() {
+                w[self.word + k] = (v >> (32 * k)) as u32;
+            }
+        }
+    }
+}
+
+/// Where port `k` of `ports` goes, and the words used up to and including it.
+const fn place(ports: &[Port], k: usize) -> (Slot, usize) {
+    let mut word = 0;
+    let mut used = 0; // bits used in `word` by narrow ports
+    let mut i = 0;
+    let mut slot = Slot {
+        word: 0,
+        shift: 0,
+        bits: 0,
+    };
+    while i <= k {
+        let bits = ports[i].bits;
+        assert!(bits >= 1, "a port has at least one bit");
+        if bits > 32 {
+            if used > 0 {
+                word += 1;
+                used = 0;
+            }
+            slot = Slot {
+                word,
+                shift: 0,
+                bits,
+            };
+            word += bits.div_ceil(32) as usize;
+        } else {
+            if used + bits > 32 {
+                word += 1;
+                used = 0;
+            }
+            slot = Slot {
+                word,
+                shift: used,
+                bits,
+            };
+            used += bits;
+        }
+        i += 1;
+    }
+    (slot, word + if used > 0 { 1 } else { 0 })
+}
+
+/// The slots of `ports` and the number of words they take.
+pub const fn pack<const N: usize>(ports: &[Port; N]) -> ([Slot; N], usize) {
+    let mut slots = [Slot {
+        word: 0,
+        shift: 0,
+        bits: 0,
+    }; N];
+    let mut k = 0;
+    while k < N {
+        slots[k] = place(ports, k).0;
+        k += 1;
+    }
+    (slots, if N == 0 { 0 } else { place(ports, N - 1).1 })
+}
+
+/// The C++ type Verilator gives a port of `bits` bits is a wide array (more than 64 bits).
+fn wide(bits: u32) -> bool {
+    bits > 64
+}
+
+/// The harness header: `SNAPGEN_IN_WORDS`, `SNAPGEN_OUT_WORDS`, `snapgen_set(top, in)` (inputs
+/// from words) and `snapgen_get(top, out)` (outputs into words), for the Verilated model
+/// class `Vtop`.
+pub fn harness_header(inputs: &[Port], outputs: &[Port]) -> String {
+    let pack_dyn = |ports: &[Port]| -> (Vec<Slot>, usize) {
+        let slots = (0..ports.len()).map(|k| place(ports, k).0).collect();
+        (
+            slots,
+            ports.len().checked_sub(1).map_or(0, |k| place(ports, k).1),
+        )
+    };
+    let (ins, in_words) = pack_dyn(inputs);
+    let (outs, out_words) = pack_dyn(outputs);
+    let mut s = String::from(
+        "// Generated by snapgen-sim from its port tables (sim/src/layout.rs). Do not edit.\n\
+         #pragma once\n#include <cstdint>\n",
+    );
+    s.push_str(&format!(
+        "#define SNAPGEN_IN_WORDS {in_words}\n#define SNAPGEN_OUT_WORDS {out_words}\n\n"
+    ));
+    s.push_str("static inline void snapgen_set(Vtop* t, const uint32_t* in) {\n");
+    for (p, sl) in inputs.iter().zip(&ins) {
+        let w = sl.word;
+        if wide(p.bits) {
+            for k in 0..sl.words() {
+                s.push_str(&format!("    t->{}[{k}] = in[{}];\n", p.name, w + k));
+            }
+        } else if p.bits > 32 {
+            s.push_str(&format!(
+                "    t->{} = (uint64_t)in[{w}] | ((uint64_t)in[{}] << 32);\n",
+                p.name,
+                w + 1
+            ));
+        } else {
+            s.push_str(&format!(
+                "    t->{} = (in[{w}] >> {}) & 0x{:x}u;\n",
+                p.name,
+                sl.shift,
+                sl.mask()
+            ));
+        }
+    }
+    s.push_str("}\n\nstatic inline void snapgen_get(const Vtop* t, uint32_t* out) {\n");
+    let mut narrow: Vec<Vec<String>> = vec![Vec::new(); out_words];
+    for (p, sl) in outputs.iter().zip(&outs) {
+        let w = sl.word;
+        if wide(p.bits) {
+            for k in 0..sl.words() {
+                s.push_str(&format!("    out[{}] = t->{}[{k}];\n", w + k, p.name));
+            }
+        } else if p.bits > 32 {
+            s.push_str(&format!("    out[{w}] = (uint32_t)t->{};\n", p.name));
+            s.push_str(&format!(
+                "    out[{}] = (uint32_t)(t->{} >> 32);\n",
+                w + 1,
+                p.name
+            ));
+        } else {
+            narrow[w].push(format!("((uint32_t)t->{} << {})", p.name, sl.shift));
+        }
+    }
+    for (w, terms) in narrow.iter().enumerate() {
+        if !terms.is_empty() {
+            s.push_str(&format!("    out[{w}] = {};\n", terms.join(" | ")));
+        }
+    }
+    s.push_str("}\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PORTS: [Port; 5] = [
+        Port { name: "a", bits: 1 },
+        Port {
+            name: "b",
+            bits: 104,
+        },
+        Port {
+            name: "c",
+            bits: 20,
+        },
+        Port {
+            name: "d",
+            bits: 20,
+        },
+        Port {
+            name: "e",
+            bits: 64,
+        },
+    ];
+
+    #[test]
+    fn packing_by_hand() {
+        let (s, n) = pack(&PORTS);
+        assert_eq!(
+            s[0],
+            Slot {
+                word: 0,
+                shift: 0,
+                bits: 1
+            }
+        );
+        assert_eq!(
+            s[1],
+            Slot {
+                word: 1,
+                shift: 0,
+                bits: 104
+            }
+        );
+        assert_eq!(
+            s[2],
+            Slot {
+                word: 5,
+                shift: 0,
+                bits: 20
+            }
+        );
+        assert_eq!(
+            s[3],
+            Slot {
+                word: 6,
+                shift: 0,
+                bits: 20
+            }
+        );
+        assert_eq!(
+            s[4],
+            Slot {
+                word: 7,
+                shift: 0,
+                bits: 64
+            }
+        );
+        assert_eq!(n, 9);
+        let h = harness_header(&PORTS, &PORTS);
+        assert!(h.contains("#define SNAPGEN_IN_WORDS 9"));
+        assert!(h.contains("t->b[3] = in[4];"));
+        assert!(h.contains("t->e = (uint64_t)in[7] | ((uint64_t)in[8] << 32);"));
+        assert!(h.contains("out[0] = ((uint32_t)t->a << 0);"));
+    }
+
+    #[test]
+    fn put_then_get() {
+        let (s, n) = pack(&PORTS);
+        let mut w = vec![0u32; n];
+        let vals = [
+            1u128,
+            (1 << 103) | 12345,
+            0xabcde,
+            0x12345,
+            u128::from(u64::MAX - 7),
+        ];
+        for (sl, v) in s.iter().zip(vals) {
+            sl.put(&mut w, v);
+        }
+        for (sl, v) in s.iter().zip(vals) {
+            assert_eq!(sl.get(&w), v);
+        }
+    }
+}
