@@ -81,7 +81,8 @@ fn order4() -> impl Strategy<Value = (f64, Method)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+    // 128 cases unless PROPTEST_CASES says otherwise (each integrates up to 3e5 ticks).
+    #![proptest_config(ProptestConfig::with_cases(util::proptest_cases(128)))]
 
     /// The planner's phase times and continuous snap, integrated independently, reach the
     /// distance within the limits; the re-derived relations agree with the integration.

@@ -5,20 +5,22 @@ mod util;
 
 use std::f64::consts::PI;
 
+use ethnum::I256;
 use snapgen_model::{
     plan, plan_from, Format, Method, MoveRequest, PhaseTicks, Plan, PlanError, Quantity,
     DEFAULT_FORMAT,
 };
-use util::{assert_plan_promises, traced};
+use util::{assert_plan_promises, integrated, peak_physical, traced};
 
 fn ok(distance: f64, method: Method, f: &Format) -> Plan {
     let p = plan(&MoveRequest { distance, method }, f)
         .unwrap_or_else(|e| panic!("{distance} {method:?}: {e}"));
-    assert_plan_promises(&p);
+    let r = assert_plan_promises(&p);
     let (_, last) = traced(&p);
     assert_eq!(
-        last, p.final_state,
-        "per-tick trace disagrees with closed form"
+        [last.x, last.v, last.a, last.j].map(I256::from),
+        [r.end.x, r.end.v, r.end.a, r.end.j],
+        "the model's per-tick chain disagrees with the independent integration"
     );
     p
 }
@@ -141,7 +143,7 @@ fn every_limit_active_with_hand_derived_phases() {
         (Quantity::Jerk, 50.0),
         (Quantity::Snap, 1000.0),
     ] {
-        let r = p.peak_physical(q) / lim;
+        let r = peak_physical(&p, &integrated(&p), q) / lim;
         assert!((0.9999..=1.0).contains(&r), "{}: {r}", q.name());
     }
 }
@@ -149,7 +151,7 @@ fn every_limit_active_with_hand_derived_phases() {
 /// Asserts that `q` is the active limit: its peak is within 1 % of the limit (rounding the
 /// phase times up to whole ticks lowers the amplitude a little).
 fn assert_active(p: &Plan, q: Quantity, limit: f64) {
-    let r = p.peak_physical(q) / limit;
+    let r = peak_physical(p, &integrated(p), q) / limit;
     assert!(
         (0.99..=1.0).contains(&r),
         "{} is not active: peak/limit = {r}",
@@ -255,8 +257,10 @@ fn long_moves_near_the_format_range() {
         &f,
     )
     .unwrap();
-    assert_plan_promises(&p);
-    assert!(p.ticks_total() > 1_000_000_000, "{}", p.ticks_total());
+    // Every promise checked by the independent closed-form integration, whose per-tick
+    // extremes cover all 1.2e9 ticks.
+    let r = assert_plan_promises(&p);
+    assert!(r.ticks > 1_000_000_000, "{}", r.ticks);
     // A snap phase of 10 s (d = 1e-3 units/s^4) puts the position gain past 2^80: the exact
     // endpoint would be lost, so the move is rejected with a typed error.
     let creep = Method::Order4 {
@@ -307,12 +311,13 @@ fn seed001_table_1() {
     assert!((v.t_acc - 0.72).abs() < 1e-12 && (v.t_jerk - 0.18).abs() < 1e-12);
     // The integer trace reaches the table's values: it is exact up to the rounding of the
     // target to whole LSBs (1.6e-7 of 37.7 units).
+    let r = integrated(&p);
     for (q, want) in [
         (Quantity::Velocity, 34.9065),
         (Quantity::Acceleration, 64.6418),
         (Quantity::Jerk, 359.1212),
     ] {
-        assert_eq!(trunc4(p.peak_physical(q)), want, "{}", q.name());
+        assert_eq!(trunc4(peak_physical(&p, &r, q)), want, "{}", q.name());
     }
     assert_eq!(p.phases, phases(0, 18_000, 36_000, 36_000));
     // T = 1.8 s plus the one tick an impulse program needs to settle.
@@ -337,12 +342,13 @@ fn seed001_table_3_returns_exactly() {
         there.final_state,
     )
     .unwrap();
-    assert_plan_promises(&back);
+    let r = assert_plan_promises(&back);
     let v = back.duration_values.unwrap();
     assert!(v.velocity < 0.0 && v.acceleration < 0.0 && v.jerk < 0.0);
     assert_eq!((v.velocity * 1e4).trunc() / 1e4, -34.9065);
-    assert_eq!(back.final_state.x, f.home_raw());
-    assert!(back.final_state.is_at_rest());
+    // Back on the very register the first move started from, at rest.
+    assert_eq!(r.end.x, I256::from(f.home_raw()));
+    assert!(r.end.at_rest());
 }
 
 #[test]
@@ -357,7 +363,7 @@ fn zero_distance_is_an_empty_program() {
         &DEFAULT_FORMAT,
     );
     assert_eq!(p.ticks_total(), 0);
-    assert_eq!(p.final_state, p.start);
+    assert_eq!(integrated(&p).end.x, I256::from(p.start.x));
 }
 
 #[test]
@@ -445,4 +451,46 @@ fn bad_inputs_are_typed_errors() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("Ts = 0 s is invalid"), "{e}");
+}
+
+/// The independent check is not vacuous: a plan whose program was tampered with after planning
+/// fails it (its own fields still say what the planner computed).
+#[test]
+fn the_promises_check_fails_on_a_tampered_program() {
+    let good = ok(
+        0.5,
+        Method::Order4 {
+            vmax: 1.0,
+            amax: 5.0,
+            jmax: 50.0,
+            dmax: 1000.0,
+        },
+        &DEFAULT_FORMAT,
+    );
+    let tamper = |edit: &dyn Fn(&mut Plan)| {
+        let mut p = good.clone();
+        edit(&mut p);
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| assert_plan_promises(&p))).is_err()
+    };
+    // One snap value one LSB larger: the move no longer ends at rest.
+    assert!(tamper(&|p| p.program.segments[0].snap += 1));
+    // Every snap 1 % larger (a cruise one tick longer to compensate would not help): the
+    // velocity limit is exceeded and the position misses.
+    assert!(tamper(&|p| {
+        for s in &mut p.program.segments {
+            s.snap += s.snap / 100;
+        }
+    }));
+    // One more cruise tick (the longest segment): at rest, but past the target cell.
+    let cruise = (0..good.program.segments.len())
+        .max_by_key(|&k| good.program.segments[k].ticks)
+        .unwrap();
+    assert_eq!(good.program.segments[cruise].snap, 0);
+    assert!(tamper(&|p| p.program.segments[cruise].ticks += 1));
+    // The last segment dropped: not at rest.
+    assert!(tamper(&|p| {
+        p.program.segments.pop();
+    }));
+    // The untampered plan passes.
+    assert!(!tamper(&|_| {}));
 }

@@ -2,7 +2,17 @@
 #![allow(dead_code)]
 
 use ethnum::I256;
-use snapgen_model::{Format, Method, Plan, PlanError, Quantity, Trace};
+use snapgen_model::{Format, Method, Plan, PlanError, Quantity, Trace, FRAC_BITS};
+pub use snapgen_verify::{integrate, Integration, State};
+
+/// The case count of a property: `PROPTEST_CASES` when set (as proptest's own default
+/// configuration reads it), else `default`.
+pub fn proptest_cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(default)
+}
 
 /// The limits a method requests, as `(quantity, value)`.
 pub fn limits(m: &Method) -> Vec<(Quantity, f64)> {
@@ -40,18 +50,50 @@ pub fn raw_limit(f: &Format, q: Quantity, limit: f64) -> I256 {
     }
 }
 
-/// The exact peak the plan reports for `q`.
-pub fn peak(p: &Plan, q: Quantity) -> I256 {
-    match q {
-        Quantity::Position => p.peaks.x,
-        Quantity::Velocity => p.peaks.v,
-        Quantity::Acceleration => p.peaks.a,
-        Quantity::Jerk => p.peaks.j,
-        Quantity::Snap => p.peaks.d,
-    }
+/// The plan's program integrated independently from its start (snapgen-verify: exact, closed
+/// form per segment, per-tick extremes; none of the planner's numbers).
+pub fn integrated(p: &Plan) -> Integration {
+    integrate_from(p.start, &p.program)
 }
 
-/// Peaks measured by stepping the program tick by tick (x, v, a, j, d), and the last state.
+/// `program` integrated from `start` by snapgen-verify.
+pub fn integrate_from(
+    start: snapgen_model::ChainState,
+    program: &snapgen_model::Program,
+) -> Integration {
+    integrate(
+        State::new(start.x, start.v, start.a, start.j),
+        program
+            .segments
+            .iter()
+            .map(|g| (u64::from(g.ticks), g.snap)),
+    )
+}
+
+/// The largest magnitude of `q` over every tick of an integration.
+pub fn peak(r: &Integration, q: Quantity) -> I256 {
+    r.range(match q {
+        Quantity::Position => 0,
+        Quantity::Velocity => 1,
+        Quantity::Acceleration => 2,
+        Quantity::Jerk => 3,
+        Quantity::Snap => 4,
+    })
+    .max_abs()
+}
+
+/// The same in physical units.
+pub fn peak_physical(p: &Plan, r: &Integration, q: Quantity) -> f64 {
+    peak(r, q).as_f64() / p.format.scale(q)
+}
+
+/// Whole output LSBs of an exact position register: `floor(x / 2^FRAC_BITS)`.
+pub fn output_cell(x: I256) -> I256 {
+    x >> FRAC_BITS
+}
+
+/// Peaks measured by stepping the program tick by tick with the model's chain (x, v, a, j, d),
+/// and the last state.
 pub fn traced(p: &Plan) -> ([I256; 5], snapgen_model::ChainState) {
     let mut m = [I256::ZERO; 5];
     let mut last = p.start;
@@ -78,26 +120,24 @@ pub fn is_range_error(e: &PlanError) -> bool {
     )
 }
 
-/// Asserts everything an accepted plan promises, from its closed-form results.
-pub fn assert_plan_promises(p: &Plan) {
+/// Asserts everything an accepted plan promises, on the independent integration of its
+/// program: at rest at the end, on the requested output cell, within every limit and every
+/// register's width on every tick. Returns the integration.
+pub fn assert_plan_promises(p: &Plan) -> Integration {
     let f = &p.format;
-    assert!(
-        p.final_state.is_at_rest(),
-        "not at rest: {:?}",
-        p.final_state
-    );
-    assert_eq!(p.final_error_lsb(), 0, "output position misses the target");
-    assert!(
-        p.residual_raw().abs() < f.half_lsb_raw(),
-        "residual {} ≥ half an LSB",
-        p.residual_raw()
-    );
+    let r = integrated(p);
+    assert!(r.end.at_rest(), "not at rest: {:?}", r.end);
+    // The request rounded to whole output LSBs, measured from the start's output cell.
+    let want = (p.request.distance / f.position_lsb).round();
+    let moved = output_cell(r.end.x) - output_cell(I256::from(p.start.x));
+    assert_eq!(moved.as_f64(), want, "output position misses the target");
     for (q, limit) in limits(&p.request.method) {
         assert!(
-            peak(p, q) <= raw_limit(f, q, limit),
-            "{} peak {} above limit {limit} (raw {})",
+            peak(&r, q) <= raw_limit(f, q, limit),
+            "{} peak {} above limit {limit} (raw {} > {})",
             q.name(),
-            p.peak_physical(q),
+            peak_physical(p, &r, q),
+            peak(&r, q),
             raw_limit(f, q, limit)
         );
     }
@@ -109,10 +149,18 @@ pub fn assert_plan_promises(p: &Plan) {
         Quantity::Snap,
     ] {
         assert!(
-            peak(p, q) <= I256::from(Format::register_max(f.width(q))),
+            peak(&r, q) <= I256::from(Format::register_max(f.width(q))),
             "{} register overflows",
             q.name()
         );
     }
+    assert_eq!(u128::from(r.ticks), u128::from(p.ticks_total()));
     p.program.validate(f).expect("program fits the format");
+    // What the plan reports about itself is what its program does.
+    assert_eq!(
+        I256::from(p.final_state.x),
+        r.end.x,
+        "the plan's final state is not where its program ends"
+    );
+    r
 }
