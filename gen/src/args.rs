@@ -56,12 +56,14 @@ pub struct PlanArgs {
     /// Seed 001 jerk-time factor φ ∈ (0, 0.5]: T_jerk = φ·T_acc.
     #[arg(long, allow_hyphen_values = true)]
     pub phi: Option<f64>,
-    /// Tick (sampling) period Ts (s).
-    #[arg(long, default_value_t = DEFAULT_FORMAT.ts, allow_hyphen_values = true)]
-    pub ts: f64,
-    /// Physical size of one output position LSB (units).
-    #[arg(long, default_value_t = DEFAULT_FORMAT.position_lsb, allow_hyphen_values = true)]
-    pub lsb: f64,
+    /// Tick (sampling) period Ts (s) [default: 1e-5; `send`: the board's, and a different
+    /// one is refused].
+    #[arg(long, allow_hyphen_values = true)]
+    pub ts: Option<f64>,
+    /// Physical size of one output position LSB (units) [default: 1e-6; `send --motor`: one
+    /// count of the motor's encoder, in rad].
+    #[arg(long, allow_hyphen_values = true)]
+    pub lsb: Option<f64>,
 }
 
 fn need(method: &'static str, flag: &'static str, v: Option<f64>) -> Result<f64, ArgError> {
@@ -79,8 +81,8 @@ impl PlanArgs {
     /// The format these arguments select.
     pub fn format(&self) -> Format {
         Format {
-            ts: self.ts,
-            position_lsb: self.lsb,
+            ts: self.ts.unwrap_or(DEFAULT_FORMAT.ts),
+            position_lsb: self.lsb.unwrap_or(DEFAULT_FORMAT.position_lsb),
             ..DEFAULT_FORMAT
         }
     }

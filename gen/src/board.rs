@@ -1,11 +1,15 @@
 //! `snapgen board --pty`: a virtual board behind a pseudo-terminal.
 //!
-//! Behind it runs either the fabric — the Verilated I/O top (`--fabric`, the default): UART
-//! command interface, motion core, encoder decoder, PWM — or the device model
-//! (`snapgen_model::device::Device`, `--model`), so that `snapgen send --port <path>` runs
-//! exactly as against a real board. Simulated time runs at `--clocks-per-second` of wall time;
-//! the tick divider is set so that Ts = 10 µs in real time. The fabric's UART runs at 16 clocks
-//! per bit (the real board's top uses 1085 for 115 200 baud at 125 MHz).
+//! Behind it runs the fabric — the Verilated I/O top (the default) — or the device model
+//! (`--model`), in real time: the design's clock frequency in simulated clocks per second of
+//! wall time, so its UART runs at the baud rate its identity reports, its tick at the Ts it
+//! reports and its watchdog in real milliseconds. `snapgen send --port <path>` runs exactly as
+//! against a real board.
+//!
+//! The default virtual design runs a 1.5 MHz clock (what the simulation keeps up with in real
+//! time): 115 200 baud is 13 clocks per bit (115 385 baud, 0.16 % off), and Ts = 100 µs is 150
+//! clocks, long enough that the stop unit's decision (about 130 clocks) never makes a
+//! stopping tick wait.
 
 use std::io::Write;
 use std::os::fd::{AsFd, AsRawFd, OwnedFd};
@@ -15,98 +19,28 @@ use anyhow::Context;
 use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
 use nix::pty::openpty;
 use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
-use snapgen_model::device::{Device, DeviceConfig};
-use snapgen_model::DEFAULT_FORMAT;
-
-/// A partial frame older than this is dropped.
-const INTER_BYTE_TIMEOUT: Duration = Duration::from_millis(20);
+use snapgen_model::device::Design;
+use snapgen_sim::board::VirtualBoard;
 
 /// Output bytes kept while nobody reads the pseudo-terminal.
 const MAX_PENDING: usize = 64 * 1024;
 
+/// The virtual board's default clock (Hz).
+pub const VIRTUAL_CLOCK_HZ: f64 = 1.5e6;
+/// The virtual board's default Ts (s).
+pub const VIRTUAL_TS: f64 = 1e-4;
+/// The simulated motor's integration step (s; docs/PLANT.md).
+pub const MOTOR_STEP_S: f64 = 1e-6;
+
 /// Board settings.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct BoardOptions {
-    /// Simulated fabric clocks per second of wall time.
-    pub clocks_per_second: u64,
+    /// The design to run (checked and hashed).
+    pub design: Design,
     /// Run the Verilated I/O top (true) or the device model (false).
     pub fabric: bool,
-}
-
-/// What serves the protocol.
-trait Target {
-    fn receive(&mut self, bytes: &[u8]);
-    fn run(&mut self, clocks: u64);
-    fn take_output(&mut self) -> Vec<u8>;
-    /// A partial frame is held (host-side inter-byte timeout for the model).
-    fn mid_frame(&self) -> bool;
-    fn timeout(&mut self);
-}
-
-impl Target for Device {
-    fn receive(&mut self, bytes: &[u8]) {
-        Device::receive(self, bytes)
-    }
-    fn run(&mut self, clocks: u64) {
-        Device::run(self, clocks)
-    }
-    fn take_output(&mut self) -> Vec<u8> {
-        Device::take_output(self)
-    }
-    fn mid_frame(&self) -> bool {
-        Device::mid_frame(self)
-    }
-    fn timeout(&mut self) {
-        Device::timeout(self)
-    }
-}
-
-impl Target for snapgen_sim::board::FabricBoard {
-    fn receive(&mut self, bytes: &[u8]) {
-        snapgen_sim::board::FabricBoard::receive(self, bytes)
-    }
-    fn run(&mut self, clocks: u64) {
-        snapgen_sim::board::FabricBoard::run(self, clocks)
-    }
-    fn take_output(&mut self) -> Vec<u8> {
-        snapgen_sim::board::FabricBoard::take_output(self)
-    }
-    // The fabric times out partial frames itself.
-    fn mid_frame(&self) -> bool {
-        false
-    }
-    fn timeout(&mut self) {}
-}
-
-/// UART clocks per bit of the virtual fabric board.
-const VIRTUAL_UART_DIVISOR: u16 = 16;
-
-fn target(opts: &BoardOptions) -> anyhow::Result<Box<dyn Target>> {
-    // Ts = 10 µs of wall time: clocks per tick = clocks_per_second / 100 000.
-    let tick_div = (opts.clocks_per_second / 100_000).max(1) as u32 - 1;
-    if !opts.fabric {
-        return Ok(Box::new(Device::new(
-            &DEFAULT_FORMAT,
-            DeviceConfig {
-                tick_div,
-                ..Default::default()
-            },
-        )));
-    }
-    let cfg = snapgen_hdl::io_top::IoTopConfig {
-        uart_divisor: VIRTUAL_UART_DIVISOR,
-        frame_timeout: (opts.clocks_per_second / 50) as u32,
-        tick_div,
-        heartbeat_bit: 20,
-    };
-    let verilog = snapgen_hdl::verilog::io_top_verilog(cfg);
-    let built = snapgen_sim::build::build_io(&verilog)?;
-    Ok(Box::new(snapgen_sim::board::FabricBoard::open(
-        &built.library,
-        snapgen_sim::board::FabricBoardConfig {
-            uart_divisor: VIRTUAL_UART_DIVISOR,
-        },
-    )?))
+    /// A simulated motor instead of the ideal follower.
+    pub motor: Option<snapgen_plant::PlantParams>,
 }
 
 fn path_of(fd: &OwnedFd) -> anyhow::Result<String> {
@@ -125,15 +59,33 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
         tcsetattr(fd, SetArg::TCSANOW, &t).context("tcsetattr")?;
     }
     let path = path_of(&pty.slave)?;
-    let mut device = target(&opts)?;
+    let d = opts.design;
+    let mut board = if opts.fabric {
+        VirtualBoard::fabric(&d)?
+    } else {
+        VirtualBoard::model(&d)
+    };
+    if let Some(m) = &opts.motor {
+        board = board.with_motor(&m.physical(), MOTOR_STEP_S)?;
+        eprintln!(
+            "motor: {} with {}; {} counts per turn: plan with --lsb {} (rad) and give send --motor",
+            m.motor.name,
+            m.load.description,
+            m.physical().counts_per_rev,
+            m.physical().rad_per_count()
+        );
+    }
     eprintln!(
-        "virtual board on {path}: {} at {} clocks/s (Ctrl-C to stop)",
+        "virtual board on {path}: {} at {} Hz, {} baud, Ts {} s, design hash {:#010x} (Ctrl-C to stop)",
         if opts.fabric {
             "Verilated I/O top"
         } else {
             "device model"
         },
-        opts.clocks_per_second
+        d.clock_hz,
+        d.baud,
+        d.ts(),
+        d.design_hash
     );
     // The path goes out once the board is ready (the fabric may have needed a build).
     println!("{path}");
@@ -142,11 +94,13 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
     // Keep the slave open: the pty stays usable between clients.
     let _slave = pty.slave;
     let start = Instant::now();
-    let mut clocks_done: u64 = 0;
+    let clock_hz = f64::from(d.clock_hz);
+    // At most this much simulated time per round, so input is read often even when the
+    // simulation falls behind.
+    let max_round = (clock_hz / 50.0) as u64;
     let mut buf = [0u8; 4096];
-    let mut last_byte = Instant::now();
-    let debug = std::env::var_os("SNAPGEN_BOARD_DEBUG").is_some();
     let mut pending: Vec<u8> = Vec::new();
+    let mut warned = false;
     let flags =
         nix::fcntl::fcntl(master.as_raw_fd(), nix::fcntl::FcntlArg::F_GETFL).context("fcntl")?;
     nix::fcntl::fcntl(
@@ -165,38 +119,26 @@ pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
                 .is_some_and(|r| r.contains(PollFlags::POLLIN))
         {
             match nix::unistd::read(master.as_raw_fd(), &mut buf) {
-                Ok(n) if n > 0 => {
-                    // A gap before these bytes ends a partial frame first.
-                    if device.mid_frame() && last_byte.elapsed() > INTER_BYTE_TIMEOUT {
-                        device.timeout();
-                    }
-                    if debug {
-                        eprintln!(
-                            "rx {:02x?} mid_frame_before={}",
-                            &buf[..n],
-                            device.mid_frame()
-                        );
-                    }
-                    device.receive(&buf[..n]);
-                    last_byte = Instant::now();
-                }
+                Ok(n) if n > 0 => board.receive(&buf[..n]),
                 // EIO while no client has the slave open: wait.
                 _ => std::thread::sleep(Duration::from_millis(1)),
             }
         }
-        // Inter-byte timeout: a frame cut short is dropped (NAK FRAMING), so a corrupted
-        // length byte cannot swallow the frames that follow.
-        if device.mid_frame() && last_byte.elapsed() > INTER_BYTE_TIMEOUT {
-            device.timeout();
-        }
-        let due = (start.elapsed().as_secs_f64() * opts.clocks_per_second as f64) as u64;
-        if due > clocks_done {
-            device.run(due - clocks_done);
-            clocks_done = due;
+        let due = (start.elapsed().as_secs_f64() * clock_hz) as u64;
+        if due > board.clocks() {
+            let behind = due - board.clocks();
+            if behind > 2 * max_round && !warned {
+                eprintln!(
+                    "warning: the simulation runs slower than real time ({:.0} ms behind): its clock, UART and ticks are slower than the design says",
+                    behind as f64 / clock_hz * 1e3
+                );
+                warned = true;
+            }
+            board.run(behind.min(max_round));
         }
         // Non-blocking output: while nobody reads the other end, bytes wait here (up to a
         // bound, like a UART's transmit FIFO that overflows) instead of stalling the board.
-        pending.extend(device.take_output());
+        pending.extend(board.take_output());
         if pending.len() > MAX_PENDING {
             let drop = pending.len() - MAX_PENDING;
             pending.drain(..drop);

@@ -3,13 +3,17 @@
 //! Plans seed 001's Table 1 move (12π rad in 1.8 s, γ = 0.4, φ = 0.25) and, from where it ends,
 //! Table 3's move back to 0; then a seed 000 move in which every limit is active. Prints the
 //! plans, checks that each lands exactly on its target at rest, and writes one plot per move.
-//! Then generates the core's Verilog, builds it with Verilator, plays the three moves on it
-//! clock by clock against the model, and prints the mismatch count and Yosys' resource counts.
+//! Then generates the core's Verilog, builds it with Verilator, plays the three moves and a
+//! fourth cut by the fabric's controlled stop on it clock by clock against the model, runs the
+//! I/O top against the device model under random command streams, and prints the mismatch
+//! counts and Yosys' resource counts.
 
 use std::f64::consts::PI;
 use std::path::Path;
 
 use anyhow::{ensure, Context};
+use snapgen_model::format::Quantity;
+use snapgen_model::stop::StopLimits;
 use snapgen_model::{plan, plan_from, Format, Method, MoveRequest, Plan, DEFAULT_FORMAT};
 use snapgen_sim::cosim::CosimConfig;
 use snapgen_sim::moves::MoveSpec;
@@ -19,10 +23,13 @@ use crate::report::PlanReport;
 
 fn show(name: &str, p: &Plan, out: &Path) -> anyhow::Result<()> {
     println!("== {name}");
-    print!("{}", PlanReport::new(p).human());
+    let report = PlanReport::new(p);
+    print!("{}", report.human());
+    // Checked on the program integrated independently of the planner.
+    let end = crate::report::integrate_plan(p).end;
     ensure!(
-        p.final_state.is_at_rest() && p.final_error_lsb() == 0,
-        "{name}: the model did not end exactly on target at rest"
+        end.at_rest() && report.final_error_lsb == 0,
+        "{name}: the program does not end exactly on target at rest"
     );
     let svg = out.join(format!("{name}.svg"));
     plot::write_svg(p, name, &svg).map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
@@ -63,7 +70,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     )?;
     show("seed001_table3_return", &back, out)?;
     ensure!(
-        back.final_state.x == f.home_raw(),
+        crate::report::integrate_plan(&back).end.x == ethnum::I256::from(f.home_raw()),
         "the return move did not come back to exactly the start register"
     );
     println!("  round trip 0 -> 12π -> 0 ends on the start register bit for bit\n");
@@ -83,31 +90,45 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
 
     // The same three moves on the generated core, clock by clock against the model.
     println!("== fabric");
-    let files = crate::hw::write_verilog(&out.join("verilog"))?;
+    let design = snapgen_hdl::verilog::io_design(&snapgen_model::device::Design::from_timing(
+        &f,
+        &snapgen_model::timing::Timing::default(),
+    )?);
+    let files = crate::hw::write_verilog(&out.join("verilog"), &design)?;
     println!(
-        "  Verilog: {} (Verilator waivers and hints {})",
-        files.verilog.display(),
-        files.waivers.display()
+        "  Verilog: {} and {}",
+        files.core.display(),
+        files.io_top.display()
     );
-    let spec = |distance: f64, method: Method, ts: f64| MoveSpec {
-        request: MoveRequest { distance, method },
-        ts,
-        tick_div: 0,
-        stop_after: None,
-        soft_stop_after: None,
+    let spec = |distance: f64, method: Method, ts: f64| {
+        MoveSpec::plain(MoveRequest { distance, method }, ts)
+    };
+    // The seed 000 move once more, stopped by the fabric's controlled stop 20 000 ticks in
+    // (mid-move), within the move's own acceleration and jerk limits.
+    let raw = |q: Quantity, v: f64| (v * f.scale(q)).floor() as i128;
+    let stopped = MoveSpec {
+        stop_after: Some(20_000),
+        stop_limits: StopLimits {
+            jerk: raw(Quantity::Jerk, 50.0),
+            accel: raw(Quantity::Acceleration, 5.0),
+        },
+        ..spec(-0.5, seed000.request.method, f.ts)
     };
     let moves = vec![
         spec(12.0 * PI, seed001, f.ts),
         spec(-12.0 * PI, seed001, f.ts),
         spec(0.5, seed000.request.method, f.ts),
+        stopped,
     ];
-    let verilog = std::fs::read_to_string(&files.verilog)?;
+    let verilog = std::fs::read_to_string(&files.core)?;
     let mut cfg = CosimConfig::fixed(moves);
     cfg.mismatch_vcd = out.join("cosim-mismatch.vcd");
     let r = snapgen_sim::cosim::run(&verilog, &cfg)?;
     println!(
-        "  Verilator co-simulation: {} moves, {} ticks ({} clocks), {} mismatches{}",
+        "  Verilator co-simulation: {} moves ({} with a controlled stop, {} at rest after it), {} ticks ({} clocks), {} mismatches{}",
         r.moves,
+        r.stopped,
+        r.stopped - r.stops_not_at_rest,
         r.ticks,
         r.clocks,
         u32::from(r.mismatch.is_some()),
@@ -121,11 +142,75 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         anyhow::bail!("{m}; waves in {}", cfg.mismatch_vcd.display());
     }
     ensure!(
-        r.planner_disagreements == 0,
-        "the core did not end where the planner said"
+        r.planner_disagreements == 0 && r.stops_not_at_rest == 0,
+        "the core did not end where the planner said, or a stop did not end at rest"
     );
-    let res = crate::yosys::synth_xilinx(&files.verilog)?;
-    println!("  Yosys synth_xilinx (xc7, flattened): {}", res.summary());
-    ensure!(res.latches() == 0, "the core synthesised with latches");
+    // The I/O top (UART command interface, axis state machine, limit switches, emergency
+    // stop, watchdog) against the device model, under random command streams.
+    let io = snapgen_sim::io_cosim::run(
+        &snapgen_sim::io_cosim::cosim_design(),
+        &snapgen_sim::io_cosim::IoCosimConfig {
+            mismatch_vcd: out.join("io-mismatch.vcd"),
+            ..snapgen_sim::io_cosim::IoCosimConfig::new(400_000, 1, 2)
+        },
+    )?;
+    println!(
+        "  I/O top against the device model: {}; {} mismatches",
+        snapgen_sim::io_cosim::describe(&io),
+        u32::from(io.mismatch.is_some())
+    );
+    if let Some(m) = &io.mismatch {
+        anyhow::bail!("{m}; waves in {}", out.join("io-mismatch.vcd").display());
+    }
+    let res = crate::yosys::synth(
+        std::slice::from_ref(&files.core),
+        snapgen_hdl::verilog::CORE_PREFIX,
+        "xc7",
+    )?;
+    println!(
+        "  Yosys synth_xilinx (xc7, flattened, the stop unit kept apart): {}; logic-only path {:.2} ns",
+        res.resources.summary(),
+        res.path_ns
+    );
+    for (name, m) in &res.modules {
+        println!(
+            "    {name}: {}; logic-only path {:.2} ns",
+            m.resources.summary(),
+            m.path_ns
+        );
+    }
+    ensure!(
+        res.resources.latches() == 0,
+        "the core synthesised with latches"
+    );
+
+    // Seed 001's experiment, short form, on the closed loop: the Verilated I/O top drives a
+    // simulated maxon RE 40 with the paper's load; the device model compares every clock.
+    println!("\n== closed loop: seed 001's experiment (short form: `snapgen experiment seed001` runs it whole)");
+    let o = crate::experiment::Options {
+        board: crate::experiment::Board::Fabric,
+        plant: snapgen_plant::PlantParams::default_plant(),
+        clock_hz: crate::experiment::EXPERIMENT_CLOCK_HZ,
+        ts: f.ts,
+        pwm_hz: 20_000.0,
+        loop_hz: 10_000.0,
+        design: snapgen_plant::gains::LoopDesign::default(),
+        host_loop: true,
+        short: true,
+        step_s: 1e-6,
+        out: Some(out.join("seed001")),
+    };
+    let r = crate::experiment::run(&o)?;
+    print!("{}", crate::experiment::table(&r));
+    ensure!(
+        r.mismatches == Some(0),
+        "the closed loop's fabric and model disagreed"
+    );
+    ensure!(
+        r.loops
+            .iter()
+            .all(|l| l.profiles.iter().all(|p| p.landed_exactly)),
+        "a closed-loop move did not land on its plan"
+    );
     Ok(())
 }

@@ -3,39 +3,29 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use snapgen_model::device::Design;
 use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
 
 /// Files `snapgen verilog` writes.
 pub struct VerilogFiles {
-    /// The motion core.
-    pub verilog: PathBuf,
-    /// The I/O top (UART command interface, motion core, encoder, PWM) for 125 MHz.
+    /// The motion core (`snapgen_core.v`).
+    pub core: PathBuf,
+    /// The I/O top (`snapgen_io.v`: UART command interface, motion core, encoder, PWM).
     pub io_top: PathBuf,
-    /// The Verilator waiver file.
-    pub waivers: PathBuf,
 }
 
-/// Writes the motion core's Verilog (`top.v`), the I/O top (`io_top.v`) and their Verilator
-/// waivers (`verilator.vlt`).
-pub fn write_verilog(out: &Path) -> anyhow::Result<VerilogFiles> {
+/// Writes the motion core's Verilog (`snapgen_core.v`) and the I/O top of `design`
+/// (`snapgen_io.v`). Each file is self-contained (its lint waivers are written in it) and the
+/// two can be read together.
+pub fn write_verilog(out: &Path, design: &Design) -> anyhow::Result<VerilogFiles> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let verilog = out.join("top.v");
-    let io_top = out.join("io_top.v");
-    let waivers = out.join("verilator.vlt");
-    std::fs::write(
-        &io_top,
-        snapgen_hdl::verilog::io_top_verilog(snapgen_hdl::io_top::IoTopConfig::default()),
-    )
-    .with_context(|| format!("cannot write {}", io_top.display()))?;
-    std::fs::write(&verilog, snapgen_hdl::verilog::motion_core_verilog())
-        .with_context(|| format!("cannot write {}", verilog.display()))?;
-    std::fs::write(&waivers, snapgen_sim::build::WAIVERS_VLT)
-        .with_context(|| format!("cannot write {}", waivers.display()))?;
-    Ok(VerilogFiles {
-        verilog,
-        io_top,
-        waivers,
-    })
+    let core = out.join(format!("{}.v", snapgen_hdl::verilog::CORE_PREFIX));
+    let io_top = out.join(format!("{}.v", snapgen_hdl::verilog::IO_PREFIX));
+    std::fs::write(&io_top, snapgen_hdl::verilog::io_top_verilog(design))
+        .with_context(|| format!("cannot write {}", io_top.display()))?;
+    std::fs::write(&core, snapgen_hdl::verilog::motion_core_verilog())
+        .with_context(|| format!("cannot write {}", core.display()))?;
+    Ok(VerilogFiles { core, io_top })
 }
 
 /// Runs a co-simulation and prints its report; returns it.
@@ -45,8 +35,8 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     println!(
         "co-simulation: {} moves ({} aborted midway, {} with a controlled stop, {} skipped), {} ticks in {} clocks compared, {} mismatches{}",
         r.moves,
+        r.aborted,
         r.stopped,
-        r.soft_stopped,
         r.skipped,
         r.ticks,
         r.clocks,

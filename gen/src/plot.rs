@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use plotters::prelude::*;
-use snapgen_model::{Plan, Quantity, Trace};
+use snapgen_model::{Plan, Quantity as Physical, Trace};
+use snapgen_plant::fast::LoopSample;
 
 /// Number of time buckets drawn.
 const BUCKETS: u64 = 1000;
@@ -27,10 +28,10 @@ fn buckets(plan: &Plan) -> Vec<Bucket> {
         let s = t.state;
         let vals = [
             f.position_physical(s.x) - x0,
-            f.to_physical(Quantity::Velocity, s.v),
-            f.to_physical(Quantity::Acceleration, s.a),
-            f.to_physical(Quantity::Jerk, s.j),
-            f.to_physical(Quantity::Snap, t.d),
+            f.to_physical(Physical::Velocity, s.v),
+            f.to_physical(Physical::Acceleration, s.a),
+            f.to_physical(Physical::Jerk, s.j),
+            f.to_physical(Physical::Snap, t.d),
         ];
         let k = t.tick / per;
         match out.last_mut() {
@@ -95,6 +96,73 @@ pub fn write_svg(plan: &Plan, title: &str, path: &Path) -> Result<(), PlotError>
         let color = colors[i];
         chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.hi[i])), color))?;
         chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.lo[i])), color))?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// What a panel shows of a sample.
+type Quantity<'a> = dyn Fn(&LoopSample) -> f64 + 'a;
+
+/// A closed loop's runs: the position error (rad) and the control signal (V: duty × `volts_per_duty`)
+/// against time, one line per run (the seed's Figures 10, 12 and 15).
+pub fn write_loop_svg(
+    title: &str,
+    runs: &[(String, &[LoopSample])],
+    volts_per_duty: f64,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let root = SVGBackend::new(path, (1000, 700)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (head, body) = root.split_vertically(40);
+    head.titled(title, ("sans-serif", 20))?;
+    let panels = body.split_evenly((2, 1));
+    let t_end = runs
+        .iter()
+        .flat_map(|(_, s)| s.last().map(|x| x.t))
+        .fold(0.0, f64::max)
+        .max(1e-3);
+    let colors = [&BLUE, &RED, &GREEN, &MAGENTA];
+    let quantities: [(&str, &Quantity<'_>); 2] = [
+        ("position error, reference − encoder (rad)", &|s| {
+            s.error()
+        }),
+        ("control signal (V)", &|s| {
+            f64::from(s.duty) * volts_per_duty
+        }),
+    ];
+    for (area, (caption, value)) in panels.iter().zip(quantities) {
+        let (lo, hi) = runs
+            .iter()
+            .flat_map(|(_, s)| s.iter().map(value))
+            .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let pad = ((hi - lo) * 0.05).max(1e-6);
+        let mut chart = ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(70)
+            .caption(caption, ("sans-serif", 16))
+            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_label_formatter(&|y| format!("{y:.3}"))
+            .draw()?;
+        for (k, (name, samples)) in runs.iter().enumerate() {
+            let color = colors[k % colors.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    samples.iter().map(|s| (s.t, value(s))),
+                    color,
+                ))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
     }
     root.present()?;
     Ok(())

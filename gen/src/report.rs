@@ -4,10 +4,12 @@
 //! Snap values in `segments` exceed 2^53: read the JSON with a reader that keeps big integers
 //! (Python's `json` does).
 
+use ethnum::I256;
 use serde::Serialize;
 use snapgen_model::{planner::DurationValues, Plan, Quantity, Segment, FRAC_BITS};
 
-/// Peak magnitudes over the move, from the integer trace.
+/// Peak magnitudes over every tick of the move: the program integrated independently of the
+/// planner (snapgen-verify: exact, closed form per segment, per-tick extremes).
 #[derive(Serialize)]
 pub struct PeakReport {
     /// max |v| (units/s).
@@ -20,7 +22,7 @@ pub struct PeakReport {
     pub d: f64,
 }
 
-/// State at the end of the move, from the integer trace.
+/// State at the end of the move, from the same independent integration.
 #[derive(Serialize)]
 pub struct FinalReport {
     /// Output position reached (whole output LSBs × LSB, units, from the start): what the
@@ -85,9 +87,9 @@ pub struct PlanReport {
     pub amplitude_raw: i128,
     /// Amplitude after the continuous planner's last recomputation (physical, signed).
     pub continuous_amplitude: f64,
-    /// Peaks from the integer trace.
+    /// Peaks over every tick (independent integration of the program).
     pub peak: PeakReport,
-    /// Final state from the integer trace.
+    /// Final state (independent integration of the program).
     pub r#final: FinalReport,
     /// Requested distance (units).
     pub distance: f64,
@@ -122,10 +124,35 @@ pub struct PlanReport {
     pub t_jerk: Option<f64>,
 }
 
+/// A plan's program integrated from its start register by snapgen-verify (exact, closed form
+/// per segment, per-tick extremes), independently of the planner.
+pub fn integrate_plan(p: &Plan) -> snapgen_verify::Integration {
+    let s = p.start;
+    snapgen_verify::integrate(
+        snapgen_verify::State::new(s.x, s.v, s.a, s.j),
+        p.program
+            .segments
+            .iter()
+            .map(|g| (u64::from(g.ticks), g.snap)),
+    )
+}
+
 impl PlanReport {
-    /// Builds the report of a plan.
+    /// Builds the report of a plan. Its `peak`, `final` and `final_*` fields come from
+    /// integrating the program from the plan's start register with snapgen-verify, not from
+    /// the planner's own numbers.
     pub fn new(p: &Plan) -> Self {
         let f = &p.format;
+        let s = p.start;
+        let run = integrate_plan(p);
+        let physical = |q: Quantity, raw: I256| raw.as_f64() / f.scale(q);
+        let peak = |q: Quantity, k: usize| physical(q, run.range(k).max_abs());
+        // Output cells: x >> FRAC_BITS (what the fabric's position port shows).
+        let start_cell = I256::from(s.x) >> FRAC_BITS;
+        let end_cell = run.end.x >> FRAC_BITS;
+        let moved_lsb = (end_cell - start_cell).as_i128();
+        let target_centre =
+            ((start_cell + I256::from(p.target_lsb)) << FRAC_BITS) + (I256::ONE << (FRAC_BITS - 1));
         let dv: Option<DurationValues> = p.duration_values;
         let order = p.order();
         let phase_ticks = PhaseReport {
@@ -151,23 +178,23 @@ impl PlanReport {
             amplitude_raw: p.amplitude_raw,
             continuous_amplitude: p.continuous_amplitude,
             peak: PeakReport {
-                v: p.peak_physical(Quantity::Velocity),
-                a: p.peak_physical(Quantity::Acceleration),
-                j: p.peak_physical(Quantity::Jerk),
-                d: p.peak_physical(Quantity::Snap),
+                v: peak(Quantity::Velocity, 1),
+                a: peak(Quantity::Acceleration, 2),
+                j: peak(Quantity::Jerk, 3),
+                d: peak(Quantity::Snap, 4),
             },
             r#final: FinalReport {
-                x: (p.target_lsb + p.final_error_lsb()) as f64 * f.position_lsb,
-                v: p.final_physical(Quantity::Velocity),
-                a: p.final_physical(Quantity::Acceleration),
-                j: p.final_physical(Quantity::Jerk),
+                x: moved_lsb as f64 * f.position_lsb,
+                v: physical(Quantity::Velocity, run.end.v),
+                a: physical(Quantity::Acceleration, run.end.a),
+                j: physical(Quantity::Jerk, run.end.j),
             },
             distance: p.request.distance,
             target: p.target_physical(),
             target_lsb: p.target_lsb,
-            final_position_error: p.final_position_error(),
-            final_error_lsb: p.final_error_lsb(),
-            final_residual_lsb: p.residual_raw() as f64 / (1u128 << FRAC_BITS) as f64,
+            final_position_error: moved_lsb as f64 * f.position_lsb - p.request.distance,
+            final_error_lsb: moved_lsb - p.target_lsb,
+            final_residual_lsb: (run.end.x - target_centre).as_f64() / (1u128 << FRAC_BITS) as f64,
             position_lsb: f.position_lsb,
             format: FormatReport {
                 ts: f.ts,
@@ -236,7 +263,7 @@ impl PlanReport {
         );
         let _ = writeln!(
             s,
-            "  peaks (integer trace): |v| {:.6} units/s, |a| {:.6} units/s^2, |j| {:.6} units/s^3, |d| {:.6} units/s^4",
+            "  peaks (every tick, integrated independently): |v| {:.6} units/s, |a| {:.6} units/s^2, |j| {:.6} units/s^3, |d| {:.6} units/s^4",
             self.peak.v, self.peak.a, self.peak.j, self.peak.d
         );
         let _ = writeln!(

@@ -1,8 +1,8 @@
-//! Runs Yosys `synth_xilinx -family xc7` on generated Verilog and reads its cell counts.
+//! Runs Yosys `synth_xilinx` on generated Verilog: cell counts and the logic-only critical path.
 //! `$SNAPGEN_YOSYS` overrides the `yosys` binary.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::PathBuf;
 use std::process::Command;
 
 use anyhow::{bail, Context};
@@ -69,30 +69,98 @@ impl Resources {
     }
 }
 
-/// Synthesises `verilog_file` (top module `top`) for the 7 series and returns its cells.
-pub fn synth_xilinx(verilog_file: &Path) -> anyhow::Result<Resources> {
+/// Synthesis results of one design.
+#[derive(Clone, Debug)]
+pub struct SynthReport {
+    /// Cells of the whole design.
+    pub resources: Resources,
+    /// Its logic-only critical path (ns), from Yosys `sta`: the longest of its blocks.
+    pub path_ns: f64,
+    /// Each block synthesis keeps apart (the flattened top, and every module marked
+    /// `keep_hierarchy`), by module name: its own cells and critical path.
+    pub modules: BTreeMap<String, ModuleReport>,
+}
+
+/// One block of a synthesised design.
+#[derive(Clone, Debug, Default)]
+pub struct ModuleReport {
+    /// Its own cells (not those of the blocks kept apart inside it).
+    pub resources: Resources,
+    /// Its logic-only critical path (ns).
+    pub path_ns: f64,
+}
+
+/// Runs Yosys on `files` with top `top`: cell counts and the logic-only critical path.
+pub fn synth(files: &[PathBuf], top: &str, family: &str) -> anyhow::Result<SynthReport> {
     let yosys = std::env::var("SNAPGEN_YOSYS").unwrap_or_else(|_| "yosys".into());
+    let reads: Vec<String> = files
+        .iter()
+        .map(|f| format!("read_verilog {}", f.display()))
+        .collect();
     let script = format!(
-        "read_verilog {}; synth_xilinx -family xc7 -top top -flatten -noiopad; stat",
-        verilog_file.display()
+        "{}; synth_xilinx -family {family} -top {top} -flatten -noiopad; tee -q -o /dev/stdout stat; \
+         read_verilog -lib -specify +/xilinx/cells_sim.v; tee -q -o /dev/stdout sta",
+        reads.join("; ")
     );
     let out = Command::new(&yosys)
-        .args(["-q", "-p", &format!("{script}; tee -q -o /dev/stdout stat")])
+        .args(["-q", "-p", &script])
         .output()
         .with_context(|| {
-            format!(
-                "{yosys} was not found: install Yosys (Debian/Ubuntu: apt-get install yosys) or point SNAPGEN_YOSYS at it"
-            )
+            format!("{yosys} was not found: install Yosys (Debian/Ubuntu: apt-get install yosys) or point SNAPGEN_YOSYS at it")
         })?;
     if !out.status.success() {
-        bail!(
-            "yosys failed on {}:\n{}",
-            verilog_file.display(),
-            String::from_utf8_lossy(&out.stderr)
+        bail!("yosys failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let resources = parse_stat(&text)?;
+    let mut modules = parse_modules(&text)?;
+    // One arrival time per block: "Latest arrival time in 'MODULE' is PS:".
+    for l in text.lines() {
+        let Some(rest) = l.trim().strip_prefix("Latest arrival time in '") else {
+            continue;
+        };
+        let Some((name, tail)) = rest.split_once('\'') else {
+            continue;
+        };
+        let ps: f64 = tail
+            .rsplit(' ')
+            .next()
+            .and_then(|v| v.trim_end_matches(':').parse().ok())
+            .context("an arrival time Yosys printed could not be read")?;
+        modules.entry(name.to_string()).or_default().path_ns = ps / 1000.0;
+    }
+    let path_ns = modules
+        .values()
+        .map(|m| m.path_ns)
+        .reduce(f64::max)
+        .context("Yosys sta printed no arrival time")?;
+    Ok(SynthReport {
+        resources,
+        path_ns,
+        modules,
+    })
+}
+
+/// The cells of every module block (`=== NAME ===`) of Yosys' `stat`, without the design
+/// hierarchy's totals.
+fn parse_modules(text: &str) -> anyhow::Result<BTreeMap<String, ModuleReport>> {
+    let mut out = BTreeMap::new();
+    for block in text.split("=== ").skip(1) {
+        let Some((name, body)) = block.split_once(" ===") else {
+            continue;
+        };
+        if name == "design hierarchy" {
+            continue;
+        }
+        out.insert(
+            name.to_string(),
+            ModuleReport {
+                resources: parse_stat(body)?,
+                path_ns: 0.0,
+            },
         );
     }
-    parse_stat(&String::from_utf8_lossy(&out.stdout))
-        .with_context(|| format!("reading Yosys' statistics for {}", verilog_file.display()))
+    Ok(out)
 }
 
 /// The cell counts of the last `stat` block in Yosys' output.

@@ -71,30 +71,176 @@ fn build_writes_a_complete_vivado_build() {
     }
     assert!(tcl.contains("set part xc7z010clg400-1"));
     assert!(read("Makefile").contains("VIVADO ?= vivado"));
-    // The board top and the I/O top together are lint-clean under -Wall (with the waivers).
-    std::fs::write(dir.join("verilator.vlt"), snapgen_sim_waivers()).unwrap();
+    assert!(read("snapgen_io.v").contains("module snapgen_io("));
+}
+
+/// Runs `verilator --lint-only -Wall` on `files` with top `top`: no warning, no error.
+fn lint_clean(dir: &std::path::Path, top: &str, files: &[String]) {
     let lint = Command::new("verilator")
-        .current_dir(&dir)
-        .args([
-            "--lint-only",
-            "-Wall",
-            "--top-module",
-            "snapgen_zybo_z7_10",
-            "verilator.vlt",
-            "io_top.v",
-            "snapgen_zybo_z7_10.v",
-        ])
+        .current_dir(dir)
+        .args(["--lint-only", "-Wall", "--top-module", top])
+        .args(files)
         .output()
-        .unwrap();
+        .expect("verilator is installed by the test command");
     let text = String::from_utf8_lossy(&lint.stderr);
     assert!(
         lint.status.success() && !text.contains("%Warning"),
-        "{text}"
+        "{top}: {text}"
     );
 }
 
-fn snapgen_sim_waivers() -> String {
-    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../hdl/verilator.vlt")).unwrap()
+/// Every file snapgen generates — the core, the I/O top and a board build, here for another
+/// clock, baud rate and Ts than the defaults — goes into one project: read together, Verilator
+/// lints each top clean under -Wall with no configuration file, Yosys synthesises each top, the
+/// module names are unique and free of '$', and every waiver in them gives its reason.
+#[test]
+fn every_generated_file_reads_together() {
+    let dir = tmp("together");
+    let timing = ["--clock-hz", "100e6", "--baud", "921600", "--ts", "2e-5"];
+    let mut args = vec!["verilog", "--out", dir.to_str().unwrap()];
+    args.extend_from_slice(&timing);
+    let out = snapgen(&args);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("109 clocks per bit") && text.contains("2000 clocks"),
+        "{text}"
+    );
+    let mut args = vec!["build", "--out", dir.to_str().unwrap()];
+    args.extend_from_slice(&timing);
+    let out = snapgen(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".v"))
+        .collect();
+    files.sort();
+    assert_eq!(
+        files,
+        ["snapgen_core.v", "snapgen_io.v", "snapgen_zybo_z7_10.v"],
+        "files written"
+    );
+    let io = std::fs::read_to_string(dir.join("snapgen_io.v")).unwrap();
+    assert!(
+        io.contains("(109 clocks per bit)") && io.contains("tick divider 1999 after reset"),
+        "header"
+    );
+    let mut modules = Vec::new();
+    for f in &files {
+        let v = std::fs::read_to_string(dir.join(f)).unwrap();
+        let plain = v.replace("$signed", "").replace("$unsigned", "");
+        assert!(!plain.contains('$'), "{f}: a name with '$'");
+        assert!(v.contains("`default_nettype none"), "{f}");
+        for line in v.lines().filter(|l| l.contains("lint_off")) {
+            assert!(
+                line.contains("*/ //"),
+                "{f}: a waiver without its reason: {line}"
+            );
+        }
+        modules.extend(
+            v.lines()
+                .filter_map(|l| l.trim_start().strip_prefix("module "))
+                .map(|m| m.split(['(', ' ']).next().unwrap().to_string()),
+        );
+    }
+    let n = modules.len();
+    modules.sort();
+    modules.dedup();
+    assert_eq!(modules.len(), n, "a module name is defined twice");
+    for top in ["snapgen_zybo_z7_10", "snapgen_io", "snapgen_core"] {
+        lint_clean(&dir, top, &files);
+        let reads: Vec<String> = files.iter().map(|f| format!("read_verilog {f}")).collect();
+        let synth = Command::new("yosys")
+            .current_dir(&dir)
+            .args(["-q", "-p"])
+            .arg(format!(
+                "{}; synth_xilinx -family xc7 -top {top} -flatten -noiopad; tee -q -o /dev/stdout stat",
+                reads.join("; ")
+            ))
+            .output()
+            .expect("yosys is installed by the test command");
+        let stat = String::from_utf8_lossy(&synth.stdout);
+        assert!(
+            synth.status.success() && stat.contains("Number of cells"),
+            "{top}: {}",
+            String::from_utf8_lossy(&synth.stderr)
+        );
+        assert!(
+            !stat.contains("LDCE") && !stat.contains("LDPE"),
+            "{top}: a latch"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A board of one's own: a copy of the Zybo file with another name and clock builds; a
+/// broken one is refused with exit 2 and the field to change.
+#[test]
+fn a_board_file_of_ones_own() {
+    let dir = tmp("own-board");
+    std::fs::create_dir_all(&dir).unwrap();
+    let zybo = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/boards/zybo-z7-10.toml"
+    ))
+    .unwrap();
+    let mine = zybo
+        .replace("name = \"zybo-z7-10\"", "name = \"my-board\"")
+        .replace("frequency_hz = 125000000", "frequency_hz = 100000000");
+    let file = dir.join("my-board.toml");
+    std::fs::write(&file, &mine).unwrap();
+    let out_dir = dir.join("build");
+    let out = snapgen(&[
+        "build",
+        "--board-file",
+        file.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let xdc = std::fs::read_to_string(out_dir.join("snapgen_my_board.xdc")).unwrap();
+    assert!(xdc.contains("-period 10.000"), "{xdc}");
+    assert!(out_dir.join("snapgen_my_board.v").exists());
+    // A pin used twice.
+    std::fs::write(&file, mine.replace("pin = \"W15\"", "pin = \"V15\"")).unwrap();
+    let out = snapgen(&[
+        "build",
+        "--board-file",
+        file.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("my-board.toml") && err.contains("already used by pwm"),
+        "{err}"
+    );
+    // A Ts the board's clock cannot count.
+    let out = snapgen(&[
+        "build",
+        "--ts",
+        "1.0001e-5",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a whole number"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -124,7 +270,10 @@ fn unknown_board_is_a_usage_error() {
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("known boards are zybo-z7-10"), "{err}");
+    assert!(
+        err.contains("known boards are zybo-z7-10") && err.contains("--board-file"),
+        "{err}"
+    );
 }
 
 /// The CI budget: the motion core alone within 1 000 LUT, 1 500 FF and a 5 ns logic-only path.
@@ -139,5 +288,6 @@ fn synth_keeps_the_motion_core_within_budget() {
     );
     assert!(text.contains("motion core within budget"), "{text}");
     assert!(text.contains("| motion core alone"), "{text}");
+    assert!(text.contains("| stop unit"), "{text}");
     assert!(text.contains("| board top"), "{text}");
 }

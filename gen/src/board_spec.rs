@@ -1,0 +1,477 @@
+//! Board descriptions: a board is data (device, clock, pins), read from TOML and checked
+//! before anything is generated from it. The schema is documented in docs/BOARDS.md; the
+//! built-in boards live in `gen/boards/`, and `--board-file FILE` reads a user's own.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Deserialize;
+
+/// The ports of the board top (`snapgen build`), with their directions: every board file maps
+/// each of them to a package pin, and nothing else.
+pub const TOP_PORTS: [(&str, Direction, &str); 17] = [
+    ("btn_reset", Direction::In, "reset button, active high"),
+    (
+        "uart_rxd",
+        Direction::In,
+        "UART from the host into the fabric",
+    ),
+    (
+        "uart_txd",
+        Direction::Out,
+        "UART from the fabric to the host",
+    ),
+    ("enc_a", Direction::In, "encoder channel A"),
+    ("enc_b", Direction::In, "encoder channel B"),
+    ("enc_i", Direction::In, "encoder index"),
+    ("pwm", Direction::Out, "PWM to the amplifier"),
+    ("dir", Direction::Out, "direction to the amplifier"),
+    (
+        "amp_enable",
+        Direction::Out,
+        "amplifier enable (high: the amplifier may drive the motor)",
+    ),
+    (
+        "estop",
+        Direction::In,
+        "emergency stop input (polarity set by INPUT_POLARITY)",
+    ),
+    ("limit_pos", Direction::In, "positive limit switch input"),
+    ("limit_neg", Direction::In, "negative limit switch input"),
+    ("led[0]", Direction::Out, "LED: idle"),
+    ("led[1]", Direction::Out, "LED: busy"),
+    ("led[2]", Direction::Out, "LED: fault"),
+    ("led[3]", Direction::Out, "LED: heartbeat"),
+    (
+        "sysclk",
+        Direction::In,
+        "the clock (the [clock] table, not a [[pins]] entry)",
+    ),
+];
+
+/// Yosys `synth_xilinx` families Vivado can also build (7 series and UltraScale).
+pub const FAMILIES: [&str; 3] = ["xc7", "xcu", "xcup"];
+
+/// A pin's direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// Into the FPGA.
+    In,
+    /// Out of the FPGA.
+    Out,
+}
+
+impl Direction {
+    /// As written in a board file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::In => "in",
+            Direction::Out => "out",
+        }
+    }
+}
+
+/// The device's resources (for the share printed by `snapgen synth`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceResources {
+    /// LUTs.
+    pub luts: u64,
+    /// Flip-flops.
+    pub ffs: u64,
+    /// DSP48E1 slices.
+    pub dsp48e1: u64,
+    /// 36 kb block RAMs.
+    pub bram36: u64,
+}
+
+/// The board clock.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClockPin {
+    /// Top-level port.
+    pub port: String,
+    /// Package pin.
+    pub pin: String,
+    /// I/O standard.
+    pub iostandard: String,
+    /// Frequency (Hz).
+    pub frequency_hz: u64,
+}
+
+/// A named pin.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pin {
+    /// Top-level port (`led[0]` for a bit of a bus).
+    pub port: String,
+    /// Package pin.
+    pub pin: String,
+    /// I/O standard.
+    pub iostandard: String,
+    /// `in` or `out`.
+    pub direction: Direction,
+    /// What it is for.
+    pub comment: String,
+}
+
+/// A board.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Board {
+    /// Short name: lower-case letters, digits and `-` (module `snapgen_<name>`).
+    pub name: String,
+    /// Human description.
+    pub description: String,
+    /// Vivado part.
+    pub part: String,
+    /// Yosys `synth_xilinx` family.
+    pub family: String,
+    /// Device.
+    pub device: String,
+    /// Package.
+    pub package: String,
+    /// Speed grade.
+    pub speed_grade: String,
+    /// Resources.
+    pub resources: DeviceResources,
+    /// Clock.
+    pub clock: ClockPin,
+    /// The limit and emergency-stop inputs' polarity after reset (INPUT_POLARITY: bit 0
+    /// inverts limit_pos, bit 1 limit_neg, bit 2 estop; set a bit for a normally-closed
+    /// contact). Built into the bitstream; default 0.
+    #[serde(default)]
+    pub input_polarity: u8,
+    /// Pins.
+    pub pins: Vec<Pin>,
+}
+
+/// A board description that cannot be used, with what to change.
+#[derive(Debug, thiserror::Error)]
+pub enum BoardError {
+    /// No built-in board of that name.
+    #[error("unknown board {name:?}: known boards are {known}, or describe yours in a file and pass --board-file FILE (docs/BOARDS.md)")]
+    Unknown {
+        /// Asked for.
+        name: String,
+        /// Built-in names.
+        known: String,
+    },
+    /// The file cannot be read.
+    #[error("cannot read the board file {path}: {source}")]
+    Read {
+        /// Path.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Not TOML of the schema (missing or unknown key, wrong type).
+    #[error("board file {origin}: {message} (the schema is in docs/BOARDS.md)")]
+    Schema {
+        /// File or board name.
+        origin: String,
+        /// What TOML/serde said.
+        message: String,
+    },
+    /// A value the build cannot use.
+    #[error("board file {origin}: {field} = {value:?}: {fix}")]
+    Invalid {
+        /// File or board name.
+        origin: String,
+        /// The field.
+        field: String,
+        /// Its value.
+        value: String,
+        /// What to change.
+        fix: String,
+    },
+}
+
+const BUILTIN: &[(&str, &str)] = &[("zybo-z7-10", include_str!("../boards/zybo-z7-10.toml"))];
+
+/// A built-in board by name.
+pub fn builtin(name: &str) -> Result<Board, BoardError> {
+    let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name) else {
+        let known: Vec<&str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+        return Err(BoardError::Unknown {
+            name: name.to_string(),
+            known: known.join(", "),
+        });
+    };
+    Board::parse(text, name)
+}
+
+/// A board from a user's file.
+pub fn from_file(path: &Path) -> Result<Board, BoardError> {
+    let text = std::fs::read_to_string(path).map_err(|source| BoardError::Read {
+        path: path.display().to_string(),
+        source,
+    })?;
+    Board::parse(&text, &path.display().to_string())
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut c = s.chars();
+    c.next()
+        .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+impl Board {
+    /// Parses and checks a board description; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Board, BoardError> {
+        let b: Board = toml::from_str(text).map_err(|e| BoardError::Schema {
+            origin: origin.to_string(),
+            message: e.message().to_string()
+                + &e.span()
+                    .map(|s| {
+                        let line = text[..s.start].lines().count().max(1);
+                        format!(" (line {line})")
+                    })
+                    .unwrap_or_default(),
+        })?;
+        b.check(origin)?;
+        Ok(b)
+    }
+
+    /// The Verilog name of the board top.
+    pub fn top_name(&self) -> String {
+        format!("snapgen_{}", self.name.replace('-', "_"))
+    }
+
+    fn check(&self, origin: &str) -> Result<(), BoardError> {
+        let bad = |field: &str, value: &dyn std::fmt::Display, fix: &str| BoardError::Invalid {
+            origin: origin.to_string(),
+            field: field.to_string(),
+            value: value.to_string(),
+            fix: fix.to_string(),
+        };
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+            || !self.name.starts_with(|c: char| c.is_ascii_lowercase())
+        {
+            return Err(bad(
+                "name",
+                &self.name,
+                "use lower-case letters, digits and '-', starting with a letter (it names the top module and files)",
+            ));
+        }
+        for (field, value) in [
+            ("part", &self.part),
+            ("device", &self.device),
+            ("package", &self.package),
+            ("speed_grade", &self.speed_grade),
+        ] {
+            if value.trim().is_empty() {
+                return Err(bad(
+                    field,
+                    value,
+                    "give the device's value (see the vendor's part list)",
+                ));
+            }
+        }
+        if !FAMILIES.contains(&self.family.as_str()) {
+            return Err(bad(
+                "family",
+                &self.family,
+                &format!(
+                    "use one of {} (Yosys synth_xilinx families that Vivado builds)",
+                    FAMILIES.join(", ")
+                ),
+            ));
+        }
+        if self.input_polarity > 7 {
+            return Err(bad(
+                "input_polarity",
+                &self.input_polarity,
+                "give 0..=7: bit 0 inverts limit_pos, bit 1 limit_neg, bit 2 estop",
+            ));
+        }
+        let r = &self.resources;
+        if r.luts == 0 || r.ffs == 0 {
+            return Err(bad(
+                "resources",
+                &format!("{} LUT, {} FF", r.luts, r.ffs),
+                "give the device's LUT and flip-flop counts (> 0)",
+            ));
+        }
+        let c = &self.clock;
+        if c.port != "sysclk" {
+            return Err(bad(
+                "clock.port",
+                &c.port,
+                "the board top's clock port is \"sysclk\"",
+            ));
+        }
+        if !(1_000_000..=1_000_000_000).contains(&c.frequency_hz) {
+            return Err(bad(
+                "clock.frequency_hz",
+                &c.frequency_hz,
+                "give the oscillator's frequency in Hz, 1e6 to 1e9",
+            ));
+        }
+        let mut pins: BTreeMap<&str, &str> = BTreeMap::new();
+        let mut ports: BTreeMap<&str, Direction> = BTreeMap::new();
+        let claim = |pin: &str, iostandard: &str, field: &str| {
+            if pin.trim().is_empty() || pin.contains(char::is_whitespace) {
+                return Err(bad(
+                    &format!("{field}.pin"),
+                    &pin,
+                    "give the package pin (e.g. K17)",
+                ));
+            }
+            if iostandard.trim().is_empty() {
+                return Err(bad(
+                    &format!("{field}.iostandard"),
+                    &iostandard,
+                    "give the bank's I/O standard (e.g. LVCMOS33)",
+                ));
+            }
+            Ok::<(), BoardError>(())
+        };
+        claim(&c.pin, &c.iostandard, "clock")?;
+        pins.insert(&c.pin, &c.port);
+        ports.insert(&c.port, Direction::In);
+        for p in &self.pins {
+            let field = format!("pins[{}]", p.port);
+            claim(&p.pin, &p.iostandard, &field)?;
+            let base = p.port.split('[').next().unwrap_or("");
+            if !is_identifier(base) {
+                return Err(bad(
+                    &field,
+                    &p.port,
+                    "a port is a Verilog name, or name[bit]",
+                ));
+            }
+            if let Some(other) = pins.insert(&p.pin, &p.port) {
+                return Err(bad(
+                    &format!("{field}.pin"),
+                    &p.pin,
+                    &format!("pin {} is already used by {other}: each pin once", p.pin),
+                ));
+            }
+            if ports.insert(&p.port, p.direction).is_some() {
+                return Err(bad(&field, &p.port, "each port once"));
+            }
+        }
+        for (port, dir, what) in TOP_PORTS {
+            match ports.get(port) {
+                None => {
+                    return Err(bad(
+                        "pins",
+                        &format!("no {port}"),
+                        &format!(
+                            "add a [[pins]] entry for port {port:?} ({what}, direction \"{}\")",
+                            dir.name()
+                        ),
+                    ))
+                }
+                Some(d) if *d != dir => {
+                    return Err(bad(
+                        &format!("pins[{port}].direction"),
+                        &d.name(),
+                        &format!(
+                            "{port} is an {} of the board top",
+                            if dir == Direction::In {
+                                "input"
+                            } else {
+                                "output"
+                            }
+                        ),
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+        if let Some(extra) = ports
+            .keys()
+            .find(|p| !TOP_PORTS.iter().any(|(t, _, _)| t == *p))
+        {
+            let known: Vec<&str> = TOP_PORTS.iter().map(|(t, _, _)| *t).collect();
+            return Err(bad(
+                &format!("pins[{extra}]"),
+                extra,
+                &format!("the board top has no such port: use {}", known.join(", ")),
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_builtin_board_is_valid() {
+        let b = builtin("zybo-z7-10").unwrap();
+        assert_eq!(b.top_name(), "snapgen_zybo_z7_10");
+        assert_eq!(b.clock.frequency_hz, 125_000_000);
+    }
+
+    fn zybo_with(edit: impl Fn(&str) -> String) -> Result<Board, BoardError> {
+        Board::parse(&edit(BUILTIN[0].1), "test.toml")
+    }
+
+    #[test]
+    fn mistakes_are_named_with_what_to_change() {
+        type Edit<'a> = &'a dyn Fn(&str) -> String;
+        let cases: [(Edit, &str); 8] = [
+            (
+                &|t| t.replace("name = \"zybo-z7-10\"", "name = \"Zybo Z7\""),
+                "name = \"Zybo Z7\"",
+            ),
+            (
+                &|t| t.replace("family = \"xc7\"", "family = \"ice40\""),
+                "use one of xc7",
+            ),
+            (
+                &|t| t.replace("frequency_hz = 125000000", "frequency_hz = 0"),
+                "clock.frequency_hz",
+            ),
+            (
+                &|t| t.replace("pin = \"W15\"", "pin = \"V15\""),
+                "already used by pwm",
+            ),
+            (
+                &|t| t.replace("port = \"enc_i\"", "port = \"enc_z\""),
+                "add a [[pins]] entry for port \"enc_i\"",
+            ),
+            (
+                &|t| t.replacen("direction = \"out\"", "direction = \"in\"", 1),
+                "led[0] is an output",
+            ),
+            (
+                &|t| {
+                    t.replace(
+                        "speed_grade = \"-1\"",
+                        "speed_grade = \"-1\"\ncolour = \"red\"",
+                    )
+                },
+                "unknown field `colour`",
+            ),
+            (
+                &|t| t.replace("[resources]\n", "[resources]\nluts_x = 1\n"),
+                "unknown field `luts_x`",
+            ),
+        ];
+        for (edit, want) in cases {
+            let e = zybo_with(edit).unwrap_err().to_string();
+            assert!(e.contains(want), "{want:?} not in: {e}");
+            assert!(e.contains("test.toml"), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_unknown_builtin_points_to_board_files() {
+        let e = builtin("arty").unwrap_err().to_string();
+        assert!(
+            e.contains("known boards are zybo-z7-10") && e.contains("--board-file"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,556 @@
+//! `snapgen experiment seed001`: seed 001's experiment on the closed loop — the S-curve of
+//! Table 1, the trapezoid at 32 rad/s, an order-4 profile of the same duration, and Table 3's
+//! return — each on a motor at rest, with the controller in the fabric (at `--loop-hz`), then
+//! at the seed's 5 ms host-loop rate (with and without the feed-forward the seed's controller
+//! did not have). Prints each profile's figures beside the paper's, writes the error and the
+//! control signal against time as SVG (the seed's Figures 10, 12 and 15), and with `--json`
+//! one object.
+//!
+//! The loop runs on the Verilated I/O top with the device model in lockstep (`fabric`: every
+//! output compared on every clock; `mismatches` counts the clocks that differ), on the device
+//! model alone (`model`), or on the fast model-only loop (`fast`, `snapgen_plant::fast`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use serde::Serialize;
+use snapgen_model::device::Design;
+use snapgen_model::io::servo::ServoConfig;
+use snapgen_model::protocol::{Command, Reply};
+use snapgen_model::stop::StopLimits;
+use snapgen_model::timing::Timing;
+use snapgen_model::{Format, Quantity, DEFAULT_FORMAT};
+use snapgen_plant::fast::{FabricTiming, FastLoop, LoopSample};
+use snapgen_plant::gains::{derive, Gains, LoopDesign, LoopTiming};
+use snapgen_plant::metrics::{figures, MoveFigures, MoveSpan};
+use snapgen_plant::seed001::{profiles, PaperFigures, Profile, SETTLE_BAND};
+use snapgen_plant::{Physical, PlantParams};
+use snapgen_sim::closed_loop::{AxisSetup, ClosedLoop};
+
+/// Where the loop runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Board {
+    /// The Verilated I/O top, the device model in lockstep.
+    Fabric,
+    /// The device model alone.
+    Model,
+    /// The fast model-only loop.
+    Fast,
+}
+
+/// The experiment's settings.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Where the loop runs.
+    pub board: Board,
+    /// The plant.
+    pub plant: PlantParams,
+    /// Fabric clock (Hz).
+    pub clock_hz: f64,
+    /// Tick (s).
+    pub ts: f64,
+    /// PWM frequency (Hz).
+    pub pwm_hz: f64,
+    /// The fabric loop's rate (Hz).
+    pub loop_hz: f64,
+    /// Bandwidth and damping.
+    pub design: LoopDesign,
+    /// Also the seed's 5 ms host-loop rate.
+    pub host_loop: bool,
+    /// Only the S-curve and the trapezoid, with a shorter watch after each.
+    pub short: bool,
+    /// The plant's integration step (s).
+    pub step_s: f64,
+    /// Where the SVG plots go (none: no plots).
+    pub out: Option<PathBuf>,
+}
+
+/// One profile's outcome on one loop.
+#[derive(Clone, Debug, Serialize)]
+pub struct ProfileResult {
+    /// `scurve`, `trapezoid`, `order4`, `return`.
+    pub name: &'static str,
+    /// The figures.
+    #[serde(flatten)]
+    pub figures: MoveFigures,
+    /// The paper's.
+    pub paper: PaperFigures,
+    /// The board's registers at the end are the plan's, bit for bit (the reference landed
+    /// exactly).
+    pub landed_exactly: bool,
+    /// The samples (not in the JSON).
+    #[serde(skip)]
+    pub samples: Vec<LoopSample>,
+}
+
+/// One loop (a rate, with or without feed-forward) over the profiles.
+#[derive(Clone, Debug, Serialize)]
+pub struct LoopResult {
+    /// What it is.
+    pub name: String,
+    /// Sample rate (Hz).
+    pub loop_hz: f64,
+    /// Feed-forward on.
+    pub feed_forward: bool,
+    /// The gains.
+    pub gains: GainsReport,
+    /// The profiles.
+    pub profiles: Vec<ProfileResult>,
+}
+
+/// The gains as the JSON gives them.
+#[derive(Clone, Debug, Serialize)]
+pub struct GainsReport {
+    /// Bandwidth used (Hz).
+    pub bandwidth_hz: f64,
+    /// In volts and radians: `kp` V/rad, `ki` V/(rad·s), `kd` V·s/rad, `kv` V·s/rad, `ka`
+    /// V·s²/rad.
+    pub volts: [f64; 5],
+    /// CONFIGURE's integers: KP, KI, KD, KV, KA, INTEGRAL_LIMIT, OUTPUT_LIMIT, FOLLOWING_LIMIT.
+    pub registers: [i64; 8],
+}
+
+impl GainsReport {
+    fn of(g: &Gains) -> Self {
+        let c = &g.config;
+        GainsReport {
+            bandwidth_hz: g.bandwidth_hz,
+            volts: [g.volts.kp, g.volts.ki, g.volts.kd, g.volts.kv, g.volts.ka],
+            registers: [
+                c.kp,
+                c.ki,
+                c.kd,
+                c.kv,
+                c.ka,
+                c.integral_limit,
+                i64::from(c.output_limit),
+                i64::from(c.following_limit),
+            ],
+        }
+    }
+}
+
+/// The whole experiment.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// `seed001`.
+    pub experiment: &'static str,
+    /// Where it ran.
+    pub board: Board,
+    /// The motor.
+    pub motor: String,
+    /// Fabric clock (Hz), tick (s), PWM (Hz).
+    pub clock_hz: f64,
+    /// Tick.
+    pub ts: f64,
+    /// PWM frequency.
+    pub pwm_hz: f64,
+    /// The fabric loop's profiles (`fabric`'s figures).
+    pub profiles: Vec<ProfileResult>,
+    /// Every loop: the fabric loop first, then the 5 ms host-loop ones.
+    pub loops: Vec<LoopResult>,
+    /// Clocks the fabric's outputs differed from the model's (`fabric` only; null otherwise).
+    pub mismatches: Option<u64>,
+    /// Clocks simulated.
+    pub clocks: u64,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// The format of a board whose output LSB is one count of `p`'s encoder.
+fn format(p: &Physical, ts: f64) -> Format {
+    Format {
+        ts,
+        position_lsb: p.rad_per_count(),
+        ..DEFAULT_FORMAT
+    }
+}
+
+/// Runs it.
+pub fn run(o: &Options) -> anyhow::Result<Report> {
+    let started = std::time::Instant::now();
+    let p = o.plant.physical();
+    let timing = Timing {
+        clock_hz: o.clock_hz as u64,
+        baud: snapgen_model::timing::DEFAULT_BAUD,
+        ts: o.ts,
+    };
+    let design = snapgen_hdl::verilog::io_design(
+        &Design::from_timing(&DEFAULT_FORMAT, &timing).context("the experiment's timing")?,
+    );
+    let f = format(&p, design.ts());
+    let pwm_period = (o.clock_hz / o.pwm_hz).round();
+    if !(1.0..=32767.0).contains(&pwm_period) {
+        anyhow::bail!(
+            "--pwm-hz {}: {} clocks per PWM period at {} Hz; give a rate with 1 to 32 767",
+            o.pwm_hz,
+            pwm_period,
+            o.clock_hz
+        );
+    }
+    let pwm_period = pwm_period as u16;
+    let ticks = |hz: f64| ((1.0 / hz) / f.ts).round().clamp(1.0, 65535.0) as u16;
+    let mut loops = vec![("fabric", ticks(o.loop_hz), o.design.feed_forward)];
+    if o.host_loop {
+        loops.push(("host 5 ms", ticks(200.0), o.design.feed_forward));
+        loops.push(("host 5 ms, PID only", ticks(200.0), false));
+    }
+    let window = if o.short { 0.5 } else { 1.2 };
+    let mut all = profiles(&f, 0.05, window)?;
+    if o.short {
+        all.retain(|p| matches!(p.name, "scurve" | "trapezoid"));
+    }
+    let (mut mismatches, mut clocks) = (0u64, 0u64);
+    let mut gains = Vec::new();
+    for &(_, period, ff) in &loops {
+        gains.push(derive(
+            &p,
+            &LoopDesign {
+                feed_forward: ff,
+                ..o.design
+            },
+            &LoopTiming {
+                ts: f.ts,
+                servo_period: period,
+                pwm_period,
+            },
+        )?);
+    }
+    // Every (loop, profile) run is independent: as many at once as there are cores.
+    let jobs: Vec<(usize, usize)> = (0..loops.len())
+        .flat_map(|l| (0..all.len()).map(move |k| (l, k)))
+        .collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
+    let done = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(&(l, k)) = jobs.get(i) else { break };
+                let r = run_profile(o, &design, &f, &p, &gains[l].config, pwm_period, &all[k])
+                    .with_context(|| format!("{} on the {} loop", all[k].name, loops[l].0));
+                done.lock().expect("no worker panics").push((l, k, r));
+            });
+        }
+    });
+    let mut done = done.into_inner().expect("no worker panics");
+    done.sort_by_key(|(l, k, _)| (*l, *k));
+    let mut per_loop: Vec<Vec<ProfileResult>> = vec![Vec::new(); loops.len()];
+    for (l, _, r) in done {
+        let (r, m, c) = r?;
+        mismatches += m;
+        clocks += c;
+        per_loop[l].push(r);
+    }
+    let mut results = Vec::new();
+    for ((name, period, ff), (gains, out)) in loops.into_iter().zip(gains.iter().zip(per_loop)) {
+        results.push(LoopResult {
+            name: format!(
+                "{name} ({:.0} Hz{})",
+                1.0 / (f64::from(period) * f.ts),
+                if ff { ", feed-forward" } else { "" }
+            ),
+            loop_hz: 1.0 / (f64::from(period) * f.ts),
+            feed_forward: ff,
+            gains: GainsReport::of(gains),
+            profiles: out,
+        });
+    }
+    let report = Report {
+        experiment: "seed001",
+        board: o.board,
+        motor: o.plant.motor.name.clone(),
+        clock_hz: o.clock_hz,
+        ts: f.ts,
+        pwm_hz: o.clock_hz / f64::from(pwm_period),
+        profiles: results[0].profiles.clone(),
+        loops: results,
+        mismatches: (o.board == Board::Fabric).then_some(mismatches),
+        clocks,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    if let Some(dir) = &o.out {
+        write_plots(&report, dir, p.vs / f64::from(pwm_period))?;
+    }
+    Ok(report)
+}
+
+/// One profile on one loop: its result, the mismatches and the clocks.
+fn run_profile(
+    o: &Options,
+    design: &Design,
+    f: &Format,
+    p: &Physical,
+    servo: &ServoConfig,
+    pwm_period: u16,
+    prof: &Profile,
+) -> anyhow::Result<(ProfileResult, u64, u64)> {
+    let volts_per_duty = p.vs / f64::from(pwm_period);
+    let last_end = prof.span.window_end;
+    let record_every = (f64::from(design.clock_hz) * 1e-4).round().max(1.0) as u64;
+    let (samples, starts, landed, mismatches, clocks) = match o.board {
+        Board::Fast => {
+            let timing = FabricTiming {
+                clock_hz: f64::from(design.clock_hz),
+                clocks_per_tick: u64::from(design.dividers.tick_div) + 1,
+                pwm_period,
+            };
+            let mut l = FastLoop::new(p, f, timing, *servo, o.step_s)?;
+            let mut samples = Vec::new();
+            let mut starts = Vec::new();
+            for (t, plan) in &prof.moves {
+                l.run_until(*t, |s| samples.push(*s));
+                starts.push(l.play(&plan.program));
+            }
+            l.run_until(last_end, |s| samples.push(*s));
+            let want = prof.moves.last().map(|(_, p)| p.final_state);
+            let landed = want == Some(l.chain());
+            let clocks = (last_end * f64::from(design.clock_hz)) as u64;
+            (samples, starts, landed, 0, clocks)
+        }
+        Board::Fabric | Board::Model => {
+            let mut l =
+                ClosedLoop::new(design, p, o.step_s, o.board == Board::Fabric, record_every)?;
+            l.run(1000);
+            let stop = StopLimits {
+                jerk: (5000.0 * f.scale(Quantity::Jerk)) as i128,
+                accel: (500.0 * f.scale(Quantity::Acceleration)) as i128,
+            };
+            l.setup(&AxisSetup {
+                pwm_period,
+                servo: *servo,
+                stop,
+            })?;
+            let origin = l.time();
+            for (t, plan) in &prof.moves {
+                l.run_until(origin + t);
+                l.start(&plan.program)?;
+            }
+            let starts = l.starts();
+            // The watch after the last move, from its real start.
+            let last_start = starts.last().copied().unwrap_or(origin);
+            let last_plan = &prof.moves.last().expect("a profile has moves").1;
+            l.run_until(
+                last_start + last_plan.ticks_total() as f64 * f.ts + (last_end - prof.span.end),
+            );
+            let landed = match l.ask(Command::ReadState)? {
+                Reply::State(s) => s.x == last_plan.final_state.x && (s.v, s.a, s.j) == (0, 0, 0),
+                _ => false,
+            };
+            let samples = l.take_samples();
+            (samples, starts, landed, l.mismatches(), l.clocks())
+        }
+    };
+    // The reported move's span, from when it really started.
+    let k = prof.moves.len() - 1;
+    let start = starts.get(k).copied().unwrap_or(prof.span.start);
+    let shift = start - prof.moves[k].0;
+    let span = MoveSpan {
+        start,
+        end: prof.span.end + shift,
+        window_end: prof.span.window_end + shift,
+    };
+    let figs = figures(&samples, &span, SETTLE_BAND, volts_per_duty)
+        .context("no samples in the move's span")?;
+    Ok((
+        ProfileResult {
+            name: prof.name,
+            figures: figs,
+            paper: prof.paper,
+            landed_exactly: landed,
+            samples,
+        },
+        mismatches,
+        clocks,
+    ))
+}
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("—".to_string(), |x| format!("{x:.digits$}"))
+}
+
+/// The table the command prints.
+pub fn table(r: &Report) -> String {
+    let mut s = format!(
+        "seed 001's experiment on {}: {}, {} Hz clock, Ts {} s, PWM {:.0} Hz\n",
+        match r.board {
+            Board::Fabric => "the Verilated I/O top (the device model in lockstep)",
+            Board::Model => "the device model",
+            Board::Fast => "the fast model-only loop",
+        },
+        r.motor,
+        r.clock_hz,
+        r.ts,
+        r.pwm_hz
+    );
+    for l in &r.loops {
+        s.push_str(&format!(
+            "  {}: bandwidth {:.1} Hz; KP {} KI {} KD {} KV {} KA {}\n",
+            l.name,
+            l.gains.bandwidth_hz,
+            l.gains.registers[0],
+            l.gains.registers[1],
+            l.gains.registers[2],
+            l.gains.registers[3],
+            l.gains.registers[4]
+        ));
+    }
+    s.push_str(
+        "\nprofile    loop                                   e(T) rad   peak e rad  peak ω rad/s  peak u V  settle s  landed\n",
+    );
+    let names: Vec<&str> = r.profiles.iter().map(|p| p.name).collect();
+    for name in names {
+        let paper = r.profiles.iter().find(|p| p.name == name).map(|p| p.paper);
+        if let Some(pp) = paper {
+            s.push_str(&format!(
+                "{name:<10} {:<38} {:>8}   {:>9}   {:>11}   {:>7}   {:>7}\n",
+                "paper (Raspberry Pi, 5 ms)",
+                opt(pp.error_at_t_rad, 3),
+                "—",
+                opt(pp.peak_velocity, 1),
+                opt(pp.peak_effort, 2),
+                opt(pp.settle_s, 2)
+            ));
+        }
+        for l in &r.loops {
+            if let Some(p) = l.profiles.iter().find(|p| p.name == name) {
+                let f = &p.figures;
+                s.push_str(&format!(
+                    "{:<10} {:<38} {:>8.4}   {:>9.4}   {:>11.2}   {:>7.2}   {:>7}   {}\n",
+                    "",
+                    l.name,
+                    f.error_at_t_rad,
+                    f.peak_error_rad,
+                    f.peak_velocity,
+                    f.peak_effort,
+                    opt(f.settle_s, 3),
+                    if p.landed_exactly { "exact" } else { "NO" }
+                ));
+            }
+        }
+    }
+    s.push_str(&format!(
+        "\ne(T): reference − encoder when the reference reaches its end (rad); peak e: the largest |e| from the move's start to the end of the watch; peak u: the largest commanded voltage; settle: from T until |e| stays ≤ {SETTLE_BAND} rad; landed: the board's registers end on the plan's, bit for bit.\n"
+    ));
+    if let Some(m) = r.mismatches {
+        s.push_str(&format!(
+            "{} clocks co-simulated, {m} mismatches (fabric against model, every output on every clock), {:.1} s\n",
+            r.clocks, r.seconds
+        ));
+    } else {
+        s.push_str(&format!(
+            "{} clocks simulated, {:.1} s\n",
+            r.clocks, r.seconds
+        ));
+    }
+    s
+}
+
+/// The seed's figures: error and control signal against time, one SVG per profile.
+fn write_plots(r: &Report, dir: &Path, volts_per_duty: f64) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    for name in ["scurve", "trapezoid", "order4", "return"] {
+        let series: Vec<(String, &[LoopSample])> = r
+            .loops
+            .iter()
+            .filter_map(|l| {
+                l.profiles
+                    .iter()
+                    .find(|p| p.name == name)
+                    .map(|p| (l.name.clone(), p.samples.as_slice()))
+            })
+            .collect();
+        if series.is_empty() {
+            continue;
+        }
+        let file = match name {
+            "trapezoid" => "fig10-trapezoid.svg",
+            "scurve" => "fig12-scurve.svg",
+            "return" => "fig15-return.svg",
+            _ => "order4.svg",
+        };
+        let title = format!("seed 001, {name}: position error and control signal");
+        crate::plot::write_loop_svg(&title, &series, volts_per_duty, &dir.join(file))
+            .map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
+        println!("wrote {}", dir.join(file).display());
+    }
+    Ok(())
+}
+
+/// The default clock of the experiment's design (Hz).
+pub const EXPERIMENT_CLOCK_HZ: f64 = 10e6;
+
+/// `snapgen gains --json`.
+pub fn gains_json(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> serde_json::Value {
+    let p = plant.physical();
+    serde_json::json!({
+        "motor": plant.motor.name,
+        "plant": { "k_rad_per_s_per_v": g.plant_k, "tau_s": g.plant_tau, "counts_per_rev": p.counts_per_rev, "supply_v": p.vs },
+        "timing": { "ts": t.ts, "servo_period_ticks": t.servo_period, "sample_s": t.sample_s(), "pwm_period_clocks": t.pwm_period },
+        "bandwidth_hz": g.bandwidth_hz,
+        "volts": { "kp": g.volts.kp, "ki": g.volts.ki, "kd": g.volts.kd, "kv": g.volts.kv, "ka": g.volts.ka },
+        "duty": { "kp": g.physical.kp, "ki": g.physical.ki, "kd": g.physical.kd, "kv": g.physical.kv, "ka": g.physical.ka },
+        "configure": {
+            "SERVO_PERIOD": g.config.period, "KP": g.config.kp, "KI": g.config.ki, "KD": g.config.kd,
+            "KV": g.config.kv, "KA": g.config.ka, "INTEGRAL_LIMIT": g.config.integral_limit,
+            "OUTPUT_LIMIT": g.config.output_limit, "FOLLOWING_LIMIT": g.config.following_limit,
+            "PWM_PERIOD": t.pwm_period,
+        },
+    })
+}
+
+/// `snapgen gains`.
+pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
+    let p = plant.physical();
+    let c = &g.config;
+    format!(
+        "motor: {}\n\
+         plant: K = {:.4} rad/s per V, τ = {:.4} s (J {:.4e} kg·m², R {} Ω, Kt {} N·m/A), {} counts/rev, supply {} V\n\
+         loop: sample {} ticks of {} s ({:.0} Hz), PWM period {} clocks; bandwidth {:.2} Hz\n\
+         \n\
+         gain  volts and radians          PWM clocks, counts, samples, ticks   CONFIGURE\n\
+         KP    {:>12.5e} V/rad          {:>12.5e} per count                   {}\n\
+         KI    {:>12.5e} V/(rad·s)      {:>12.5e} per count·sample            {}\n\
+         KD    {:>12.5e} V·s/rad        {:>12.5e} per count/sample            {}\n\
+         KV    {:>12.5e} V·s/rad        {:>12.5e} per count/tick              {}\n\
+         KA    {:>12.5e} V·s²/rad       {:>12.5e} per count/tick²             {}\n\
+         INTEGRAL_LIMIT {}  OUTPUT_LIMIT {}  FOLLOWING_LIMIT {} counts  SERVO_PERIOD {}  PWM_PERIOD {}\n",
+        plant.motor.name,
+        g.plant_k,
+        g.plant_tau,
+        p.j,
+        p.r,
+        p.kt,
+        p.counts_per_rev,
+        p.vs,
+        t.servo_period,
+        t.ts,
+        1.0 / t.sample_s(),
+        t.pwm_period,
+        g.bandwidth_hz,
+        g.volts.kp,
+        g.physical.kp,
+        c.kp,
+        g.volts.ki,
+        g.physical.ki,
+        c.ki,
+        g.volts.kd,
+        g.physical.kd,
+        c.kd,
+        g.volts.kv,
+        g.physical.kv,
+        c.kv,
+        g.volts.ka,
+        g.physical.ka,
+        c.ka,
+        c.integral_limit,
+        c.output_limit,
+        c.following_limit,
+        c.period,
+        t.pwm_period,
+    )
+}

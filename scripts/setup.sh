@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what snapgen's demo and tests need beside Rust, when it is missing: Verilator (the
+# co-simulation and the lint) and Yosys (synthesis), with apt-get (as root, or through sudo).
+# Sourced by scripts/demo.sh and scripts/test.sh; safe to run again (installs nothing twice).
+set -euo pipefail
+
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "cargo is not installed: install Rust first (https://rustup.rs)" >&2
+  exit 1
+fi
+need_apt=()
+command -v verilator >/dev/null 2>&1 || need_apt+=(verilator)
+command -v yosys >/dev/null 2>&1 || need_apt+=(yosys)
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "installing ${need_apt[*]} with apt-get"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  if ! command -v apt-get >/dev/null 2>&1; then
+    echo "apt-get is not available: install ${need_apt[*]} with your package manager" >&2
+    exit 1
+  fi
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
