@@ -278,3 +278,30 @@ fn the_fast_loop_agrees_with_the_device_level_loop() {
     assert!((device.peak_velocity / quick.peak_velocity - 1.0).abs() < 0.02);
     assert!((device.peak_effort - quick.peak_effort).abs() < 0.1 * device.peak_effort);
 }
+
+/// A new tick divider takes effect on the same clock in the fabric and in the model: the tick
+/// right after the CONFIGURE is the new divider's on both (the I/O co-simulation found the
+/// model one clock late, visible only through the controller's sample timing). Ticks 10
+/// clocks apart with a sample every second tick also overrun the controller, on both alike.
+#[test]
+fn a_new_tick_divider_ticks_on_the_same_clock_in_fabric_and_model() {
+    let d = design();
+    let (s, _) = setup(&d, true);
+    let p = PlantParams::default_plant().physical();
+    let mut l = ClosedLoop::new(&d, &p, 1e-6, true, 200).unwrap();
+    l.run(200);
+    l.setup(&s).unwrap();
+    for div in [9, 99, 4, 57, 9] {
+        l.command(Command::Configure {
+            param: snapgen_model::protocol::Param::TickDivider,
+            value: div,
+        })
+        .unwrap();
+        l.run(1000);
+    }
+    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+        panic!()
+    };
+    assert!(st.has(flag::SERVO_OVERRUN), "{st:?}");
+    assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
+}
