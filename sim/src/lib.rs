@@ -21,6 +21,7 @@ pub mod io;
 pub mod io_cosim;
 pub mod layout;
 pub mod moves;
+pub mod vcd;
 pub mod wrapper;
 
 use std::path::PathBuf;

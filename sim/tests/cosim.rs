@@ -98,6 +98,9 @@ fn a_flipped_bit_is_reported_with_waves() {
             !vcd.contains("\n#3\n"),
             "dumped from the start, not a window"
         );
+        // Every clock of the window is recorded (two edges a clock), not only the first dump.
+        let edges = snapgen_sim::vcd::clock_changes(&vcd);
+        assert!(edges >= 2 * 64, "{edges} clock edges in the waves");
     }
 }
 
