@@ -884,31 +884,20 @@ fn configure_servo(
     };
     let g = snapgen_plant::gains::derive(&s.plant.physical(), &s.design, &timing)
         .map_err(|e| bad(e.to_string()))?;
-    let c = g.config;
-    let fixed = [
-        (Param::ServoPeriod, i128::from(c.period)),
-        (Param::FollowingLimit, i128::from(c.following_limit)),
-    ];
+    let writes = snapgen_model::io::executor::Config::servo_writes(&g.config);
+    // SERVO_PERIOD and FOLLOWING_LIMIT are set only while Disabled.
+    let (fixed, rest) = writes.split_at(2);
     if axis != AxisState::Disabled {
         let mut same = true;
-        for (p, v) in fixed {
+        for &(p, v) in fixed {
             same &= link.read_config(p)? == v;
         }
         if !same {
             link.expect_ack(Command::Power { on: false }, false)?;
         }
     }
-    for (p, v) in fixed.into_iter().chain([
-        (Param::PwmPeriod, i128::from(timing.pwm_period)),
-        (Param::Kp, i128::from(c.kp)),
-        (Param::Ki, i128::from(c.ki)),
-        (Param::Kd, i128::from(c.kd)),
-        (Param::Kv, i128::from(c.kv)),
-        (Param::Ka, i128::from(c.ka)),
-        (Param::IntegralLimit, i128::from(c.integral_limit)),
-        (Param::OutputLimit, i128::from(c.output_limit)),
-        (Param::DFilter, i128::from(c.d_filter)),
-    ]) {
+    let pwm = [(Param::PwmPeriod, i128::from(timing.pwm_period))];
+    for &(p, v) in fixed.iter().chain(&pwm).chain(rest) {
         // The rate and the following limit are already right when the axis stayed enabled.
         if link.read_config(p)? != v {
             link.configure(p, v)?;

@@ -341,23 +341,16 @@ impl ClosedLoop {
     /// Configures the axis (PWM, controller, stop limits; the watchdog off: the loop's host
     /// polls at its own pace) and powers it.
     pub fn setup(&mut self, s: &AxisSetup) -> Result<(), LoopError> {
-        let c = &s.servo;
-        for (param, value) in [
+        let head = [
             (Param::WatchdogMs, 0),
             (Param::PwmPeriod, i128::from(s.pwm_period)),
-            (Param::ServoPeriod, i128::from(c.period)),
-            (Param::Kp, i128::from(c.kp)),
-            (Param::Ki, i128::from(c.ki)),
-            (Param::Kd, i128::from(c.kd)),
-            (Param::Kv, i128::from(c.kv)),
-            (Param::Ka, i128::from(c.ka)),
-            (Param::IntegralLimit, i128::from(c.integral_limit)),
-            (Param::OutputLimit, i128::from(c.output_limit)),
-            (Param::FollowingLimit, i128::from(c.following_limit)),
-            (Param::DFilter, i128::from(c.d_filter)),
+        ];
+        let stop = [
             (Param::StopJerk, s.stop.jerk),
             (Param::StopAccel, s.stop.accel),
-        ] {
+        ];
+        let servo = snapgen_model::io::executor::Config::servo_writes(&s.servo);
+        for &(param, value) in head.iter().chain(&servo).chain(&stop) {
             self.command(Command::Configure { param, value })?;
         }
         self.command(Command::Power { on: true })

@@ -141,6 +141,31 @@ impl Config {
         }
     }
 
+    /// The position controller's parameters: the two set only while Disabled first.
+    pub const SERVO_PARAMS: [Param; 10] = [
+        Param::ServoPeriod,
+        Param::FollowingLimit,
+        Param::Kp,
+        Param::Ki,
+        Param::Kd,
+        Param::Kv,
+        Param::Ka,
+        Param::IntegralLimit,
+        Param::OutputLimit,
+        Param::DFilter,
+    ];
+
+    /// What CONFIGURE writes for the controller configuration `servo`, in
+    /// [`Self::SERVO_PARAMS`]' order (through [`Self::get`]: one mapping of fields to
+    /// parameters for the device and for every host).
+    pub fn servo_writes(servo: &crate::io::servo::ServoConfig) -> [(Param, i128); 10] {
+        let c = Config {
+            servo: *servo,
+            ..Default::default()
+        };
+        Self::SERVO_PARAMS.map(|p| (p, c.get(p)))
+    }
+
     /// Sets `p` to `v` (in range: CONFIGURE checks it).
     pub fn set(&mut self, p: Param, v: i128) {
         match p {
@@ -715,5 +740,39 @@ impl ReplyQueue {
                 self.items.push_back(r);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::servo::ServoConfig;
+
+    /// What a host writes for a controller configuration, replayed through CONFIGURE's
+    /// setter, is that configuration: every field has its parameter, and only one.
+    #[test]
+    fn servo_writes_round_trip_through_configure() {
+        let want = ServoConfig {
+            period: 3,
+            kp: 11,
+            ki: 12,
+            kd: 13,
+            kv: 14,
+            ka: 15,
+            integral_limit: 16,
+            output_limit: 17,
+            following_limit: 18,
+            d_filter: 4,
+        };
+        let mut c = Config::default();
+        let writes = Config::servo_writes(&want);
+        for (p, v) in writes {
+            c.set(p, v);
+        }
+        assert_eq!(c.servo, want);
+        let mut params: Vec<u8> = writes.iter().map(|(p, _)| *p as u8).collect();
+        params.sort_unstable();
+        params.dedup();
+        assert_eq!(params.len(), writes.len());
     }
 }
