@@ -476,7 +476,7 @@ fn write_plots(r: &Report, dir: &Path, volts_per_duty: f64) -> anyhow::Result<()
         let title = format!("seed 001, {name}: position error and control signal");
         crate::plot::write_loop_svg(&title, &series, volts_per_duty, &dir.join(file))
             .map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
-        println!("wrote {}", dir.join(file).display());
+        eprintln!("wrote {}", dir.join(file).display());
     }
     Ok(())
 }
@@ -498,7 +498,7 @@ pub fn gains_json(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> serde_json:
             "SERVO_PERIOD": g.config.period, "KP": g.config.kp, "KI": g.config.ki, "KD": g.config.kd,
             "KV": g.config.kv, "KA": g.config.ka, "INTEGRAL_LIMIT": g.config.integral_limit,
             "OUTPUT_LIMIT": g.config.output_limit, "FOLLOWING_LIMIT": g.config.following_limit,
-            "PWM_PERIOD": t.pwm_period,
+            "D_FILTER": g.config.d_filter, "PWM_PERIOD": t.pwm_period,
         },
     })
 }
@@ -518,7 +518,7 @@ pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
          KD    {:>12.5e} V·s/rad        {:>12.5e} per count/sample            {}\n\
          KV    {:>12.5e} V·s/rad        {:>12.5e} per count/tick              {}\n\
          KA    {:>12.5e} V·s²/rad       {:>12.5e} per count/tick²             {}\n\
-         INTEGRAL_LIMIT {}  OUTPUT_LIMIT {}  FOLLOWING_LIMIT {} counts  SERVO_PERIOD {}  PWM_PERIOD {}\n",
+         INTEGRAL_LIMIT {}  OUTPUT_LIMIT {}  FOLLOWING_LIMIT {} counts  D_FILTER {}  SERVO_PERIOD {}  PWM_PERIOD {}\n",
         plant.motor.name,
         g.plant_k,
         g.plant_tau,
@@ -550,6 +550,7 @@ pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
         c.integral_limit,
         c.output_limit,
         c.following_limit,
+        c.d_filter,
         c.period,
         t.pwm_period,
     )

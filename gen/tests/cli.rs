@@ -411,3 +411,92 @@ fn cosim_bench_refuses_waves() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--vcd"));
 }
+
+/// `experiment seed001 --json` (on the fast loop: the fabric's run is the demo's and
+/// `sim/tests/closed_loop.rs`'): stdout is one JSON object with a figure set per profile, the
+/// plots are written, and the figures are the motor's, not the plan's: the trapezoid's shaft
+/// reaches about its 32 rad/s, the S-curve's its higher peak, the loop tracks within a few
+/// counts, and every reference lands exactly.
+#[test]
+fn experiment_json_reports_every_profile() {
+    let dir = tmp("seed001");
+    let out = snapgen(&[
+        "experiment",
+        "seed001",
+        "--board",
+        "fast",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
+    assert!(v["mismatches"].is_null(), "the fast loop has no fabric");
+    let profiles = v["profiles"].as_array().unwrap();
+    let names: Vec<&str> = profiles.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["scurve", "trapezoid", "order4", "return"]);
+    let num = |p: &serde_json::Value, k: &str| p[k].as_f64().unwrap_or_else(|| panic!("{k}"));
+    for p in profiles {
+        assert_eq!(p["landed_exactly"], true, "{p}");
+        assert!(p["settle_s"].is_number() || p["settle_s"].is_null());
+        // Within 0.05 rad all the way (64 counts), and a control effort below the supply.
+        assert!(num(p, "peak_error_rad") < 0.05, "{p}");
+        assert!(num(p, "error_at_t_rad").abs() <= num(p, "peak_error_rad"));
+        assert!((0.5..48.0).contains(&num(p, "peak_effort")), "{p}");
+    }
+    let trapezoid = num(&profiles[1], "peak_velocity");
+    assert!((31.0..34.0).contains(&trapezoid), "{trapezoid}");
+    // The S-curve of Table 1 peaks at 12π/1.8/(1 − γ) = 34.9 rad/s.
+    assert!(num(&profiles[0], "peak_velocity") > trapezoid);
+    assert_eq!(v["loops"].as_array().unwrap().len(), 3, "fabric rate and the 5 ms host loop");
+    for svg in [
+        "fig12-scurve.svg",
+        "fig10-trapezoid.svg",
+        "order4.svg",
+        "fig15-return.svg",
+    ] {
+        let text = std::fs::read_to_string(dir.join(svg)).unwrap();
+        assert!(text.starts_with("<svg") && text.contains("</svg>"), "{svg}");
+    }
+}
+
+/// `gains` prints the CONFIGURE values derived from the plant, and refuses a bad design or a
+/// broken plant file with exit 2 and what to change.
+#[test]
+fn gains_prints_configure_values_and_refuses_bad_designs() {
+    let out = snapgen(&["gains", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let c = &v["configure"];
+    for k in [
+        "SERVO_PERIOD",
+        "KP",
+        "KI",
+        "KD",
+        "KV",
+        "KA",
+        "INTEGRAL_LIMIT",
+        "OUTPUT_LIMIT",
+        "FOLLOWING_LIMIT",
+        "D_FILTER",
+        "PWM_PERIOD",
+    ] {
+        assert!(c[k].is_u64(), "{k}: {c}");
+    }
+    // Kv = 1/K V per rad/s: K is the data sheet's 158 rpm/V in rad/s.
+    let k = v["plant"]["k_rad_per_s_per_v"].as_f64().unwrap();
+    assert!((k / (158.0 * 2.0 * std::f64::consts::PI / 60.0) - 1.0).abs() < 1e-9);
+    assert!((v["volts"]["kv"].as_f64().unwrap() * k - 1.0).abs() < 1e-12);
+    let out = snapgen(&["gains", "--damping", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("damping"));
+    let broken = tmp("broken-motor.toml");
+    std::fs::write(&broken, "[motor]\nname = \"x\"\n").unwrap();
+    let out = snapgen(&["gains", "--motor", broken.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("broken-motor.toml"));
+}
