@@ -301,7 +301,7 @@ impl BoardSynth {
             self.board.package,
             self.board.speed_grade,
             row(
-                "board top (I/O top: UART command interface, motion core, encoder, PWM)",
+                "board top (I/O top: UART command interface, motion core, position controller, encoder, PWM)",
                 &self.full.resources,
                 self.full.path_ns
             ),

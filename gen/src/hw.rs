@@ -10,7 +10,7 @@ use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
 pub struct VerilogFiles {
     /// The motion core (`snapgen_core.v`).
     pub core: PathBuf,
-    /// The I/O top (`snapgen_io.v`: UART command interface, motion core, encoder, PWM).
+    /// The I/O top (`snapgen_io.v`: UART command interface, motion core, position controller, encoder, PWM).
     pub io_top: PathBuf,
 }
 

@@ -312,7 +312,10 @@ enum Command {
         json: bool,
     },
     /// The main job on built-in defaults: plan the seed 001 Table 1 and Table 3 moves and a
-    /// seed 000 move, print the plans, write their plots.
+    /// seed 000 move, print the plans and write their plots; generate the Verilog, co-simulate
+    /// the core and the I/O top against the model, synthesise with Yosys; run seed 001's
+    /// experiment (short form) on the closed loop. Needs Verilator and Yosys
+    /// (`./scripts/demo.sh` installs them).
     Demo {
         /// Directory for the plots.
         #[arg(long, default_value = "out/demo")]
