@@ -437,7 +437,10 @@ fn experiment_json_reports_every_profile() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
     assert!(v["mismatches"].is_null(), "the fast loop has no fabric");
     let profiles = v["profiles"].as_array().unwrap();
-    let names: Vec<&str> = profiles.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> = profiles
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
     assert_eq!(names, ["scurve", "trapezoid", "order4", "return"]);
     let num = |p: &serde_json::Value, k: &str| p[k].as_f64().unwrap_or_else(|| panic!("{k}"));
     for p in profiles {
@@ -452,7 +455,11 @@ fn experiment_json_reports_every_profile() {
     assert!((31.0..34.0).contains(&trapezoid), "{trapezoid}");
     // The S-curve of Table 1 peaks at 12π/1.8/(1 − γ) = 34.9 rad/s.
     assert!(num(&profiles[0], "peak_velocity") > trapezoid);
-    assert_eq!(v["loops"].as_array().unwrap().len(), 3, "fabric rate and the 5 ms host loop");
+    assert_eq!(
+        v["loops"].as_array().unwrap().len(),
+        3,
+        "fabric rate and the 5 ms host loop"
+    );
     for svg in [
         "fig12-scurve.svg",
         "fig10-trapezoid.svg",

@@ -16,7 +16,7 @@ pub fn clock_changes(vcd: &str) -> usize {
     body.lines()
         .filter(|l| {
             let l = l.trim();
-            (l.starts_with('0') || l.starts_with('1')) && &l[1..] == id
+            (l.starts_with('0') || l.starts_with('1')) && l[1..] == id
         })
         .count()
 }

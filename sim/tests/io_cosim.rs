@@ -102,7 +102,10 @@ fn a_flipped_output_bit_is_reported_with_waves() {
         assert!(vcd.contains("$enddefinitions"), "a VCD file");
         // The window's clocks before the mismatch (2 000 at most) are recorded, two edges each.
         let edges = snapgen_sim::vcd::clock_changes(&vcd) as u64;
-        assert!(edges >= 2 * clock.min(2000), "{edges} clock edges in the waves");
+        assert!(
+            edges >= 2 * clock.min(2000),
+            "{edges} clock edges in the waves"
+        );
     }
     // A fault past the session's end is an error, not a clean report.
     let mut cfg = IoCosimConfig::new(1_000, 3, 1);
