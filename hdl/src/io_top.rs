@@ -402,7 +402,9 @@ impl Logic for IoTop {
         self.uart_tx.next = self.uart_out.tx.val();
         // The position controller; its duty drives the PWM (off without the amplifier).
         self.servo.reset.next = self.reset.val();
-        self.servo.enable.next = self.exec.amplifier.val();
+        // Not on the clock the reference loads the encoder's position (POWER 1): the
+        // controller's first sample comes after the load, never from the old reference.
+        self.servo.enable.next = self.exec.amplifier.val() & !self.exec.load.val();
         self.servo.tick.next = self.core.tick.val();
         self.servo.start.next = self.exec.start.val();
         // rust-hdl workaround: literal bit indices (crate::servo's REFERENCE_LOW, VELOCITY_LOW,

@@ -353,7 +353,9 @@ impl Device {
         let send = !tx_head.empty && !self.uart_tx.busy();
         let servo_in = ServoInputs {
             reset,
-            enable: exec_out.amplifier,
+            // Not on the clock the reference loads the encoder's position (POWER 1): the first
+            // sample comes after the load, never from the reference the motor left.
+            enable: exec_out.amplifier && !exec_out.load,
             tick: core_out.tick,
             start: exec_out.start,
             x: core_out.x,

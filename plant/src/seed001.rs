@@ -129,6 +129,8 @@ pub fn profiles(format: &Format, t0: f64, window: f64) -> Result<Vec<Profile>, P
                 error_at_t_rad: Some(0.049),
                 peak_velocity: None,
                 peak_effort: None,
+                // The paper gives the time to zero error (e = 0 at t = 6.5 s, T = 5.8 s): an
+                // upper bound of the time to within the band.
                 settle_s: Some(0.7),
             },
         },

@@ -305,7 +305,8 @@ impl Stream {
             ),
             13 => (Param::IntegralLimit, gain(r)),
             14 => (Param::OutputLimit, [0, 10, 150, 32767][r.gen_range(0..4)]),
-            15 => (Param::Kp, gain(r)),
+            15 if r.gen_bool(0.5) => (Param::Kp, gain(r)),
+            15 => (Param::DFilter, r.gen_range(0..16)),
             0 => (Param::TelemetryPeriod, r.gen_range(0..60)),
             1 => (Param::WatchdogMs, [0, 1, 3, 10, 1000][r.gen_range(0..5)]),
             2 | 3 => {

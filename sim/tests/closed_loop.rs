@@ -197,9 +197,34 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     }
     l.run_until(l.time() + 0.2);
     assert_eq!(l.plant().state().theta, rest.theta);
-    // Cleared: RESET, POWER: the reference takes the encoder's position and holds it.
+    // Cleared: RESET, POWER: the reference takes the encoder's position and holds it. With a
+    // tick on every clock the controller's first sample falls on the clock POWER is taken:
+    // it must see the loaded reference, not the one the motor coasted away from (which is
+    // past the following limit and would trip the fault again at once).
+    l.command(Command::Configure {
+        param: snapgen_model::protocol::Param::TickDivider,
+        value: 0,
+    })
+    .unwrap();
     l.command(Command::Reset).unwrap();
+    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+        panic!()
+    };
+    assert_eq!(st.state, AxisState::Disabled as u8);
+    // The reference is tens of counts from the motor: well past a limit of 10.
+    assert!((st.position - st.encoder).abs() > 20, "{st:?}");
+    l.command(Command::Configure {
+        param: snapgen_model::protocol::Param::FollowingLimit,
+        value: 10,
+    })
+    .unwrap();
     l.command(Command::Power { on: true }).unwrap();
+    l.run(5_000);
+    l.command(Command::Configure {
+        param: snapgen_model::protocol::Param::TickDivider,
+        value: i128::from(d.dividers.tick_div),
+    })
+    .unwrap();
     l.run_until(l.time() + 0.2);
     let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
         panic!()
