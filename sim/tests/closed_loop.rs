@@ -256,23 +256,18 @@ fn the_fast_loop_agrees_with_the_device_level_loop() {
     .unwrap();
     let secs = plan.ticks_total() as f64 * f.ts;
     let volts = p.vs / 100.0;
+    let span = |t0: f64| MoveSpan {
+        start: t0,
+        end: t0 + secs,
+        window_end: t0 + secs + 0.3,
+    };
     let mut l = ClosedLoop::new(&d, &p, 1e-6, false, 200).unwrap();
     l.run(200);
     l.setup(&s).unwrap();
     l.start(&plan.program).unwrap();
     let t0 = l.starts()[0];
     l.run_until(t0 + secs + 0.3);
-    let device = figures(
-        &l.take_samples(),
-        &MoveSpan {
-            start: t0,
-            end: t0 + secs,
-            window_end: t0 + secs + 0.3,
-        },
-        0.009,
-        volts,
-    )
-    .unwrap();
+    let device = figures(&l.take_samples(), &span(t0), 0.009, volts).unwrap();
     let timing = FabricTiming {
         clock_hz: f64::from(d.clock_hz),
         clocks_per_tick: u64::from(d.dividers.tick_div) + 1,
@@ -283,17 +278,7 @@ fn the_fast_loop_agrees_with_the_device_level_loop() {
     fast.run_until(0.01, |x| samples.push(*x));
     let t0 = fast.play(&plan.program);
     fast.run_until(t0 + secs + 0.3, |x| samples.push(*x));
-    let quick = figures(
-        &samples,
-        &MoveSpan {
-            start: t0,
-            end: t0 + secs,
-            window_end: t0 + secs + 0.3,
-        },
-        0.009,
-        volts,
-    )
-    .unwrap();
+    let quick = figures(&samples, &span(t0), 0.009, volts).unwrap();
     let count = p.rad_per_count();
     assert!(
         (device.peak_error_rad - quick.peak_error_rad).abs() <= 3.0 * count,
