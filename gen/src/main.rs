@@ -497,30 +497,32 @@ enum InputError {
 #[error("the fabric and the model disagree")]
 struct Mismatched;
 
-fn parse_fault(s: &str) -> Result<snapgen_sim::cosim::Fault, InputError> {
-    let bad = || InputError::Fault(s.to_string());
-    let mut it = s.split(':');
-    let (Some(c), Some(r), Some(b), None) = (it.next(), it.next(), it.next(), it.next()) else {
-        return Err(bad());
-    };
-    Ok(snapgen_sim::cosim::Fault {
-        clock: c.parse().map_err(|_| bad())?,
-        register: r.parse().map_err(|_| bad())?,
-        bit: b.parse().map_err(|_| bad())?,
-    })
-}
-
-fn parse_io_fault(s: &str) -> Result<snapgen_sim::io_cosim::IoFault, InputError> {
+/// `CLOCK:NAME:BIT`, the form of both co-simulations' `--inject-fault`.
+fn split_fault<T: std::str::FromStr>(s: &str) -> Result<(u64, T, u32), InputError> {
     let bad = || InputError::Fault(s.to_string());
     let mut it = s.split(':');
     let (Some(c), Some(name), Some(b), None) = (it.next(), it.next(), it.next(), it.next()) else {
         return Err(bad());
     };
-    Ok(snapgen_sim::io_cosim::IoFault {
-        clock: c.parse().map_err(|_| bad())?,
-        signal: name.parse().map_err(|_| bad())?,
-        bit: b.parse().map_err(|_| bad())?,
+    Ok((
+        c.parse().map_err(|_| bad())?,
+        name.parse().map_err(|_| bad())?,
+        b.parse().map_err(|_| bad())?,
+    ))
+}
+
+fn parse_fault(s: &str) -> Result<snapgen_sim::cosim::Fault, InputError> {
+    let (clock, register, bit) = split_fault(s)?;
+    Ok(snapgen_sim::cosim::Fault {
+        clock,
+        register,
+        bit,
     })
+}
+
+fn parse_io_fault(s: &str) -> Result<snapgen_sim::io_cosim::IoFault, InputError> {
+    let (clock, signal, bit) = split_fault(s)?;
+    Ok(snapgen_sim::io_cosim::IoFault { clock, signal, bit })
 }
 
 fn make_plan(a: &PlanArgs) -> Result<Plan, InputError> {
