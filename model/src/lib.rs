@@ -6,6 +6,7 @@
 //! * [`peaks`]: exact register peaks over a program.
 //! * [`timing`]: the clock, UART and tick dividers the fabric is generated for.
 //! * [`stop`]: the fabric's controlled stop from any state (the law, exact).
+//! * [`online`]: planning from any exact state (seed 002's adaptive S-curve, PLCopen moves).
 //! * [`planner`]: seed 000 (order 4), orders 3 and 2, seed 001 (duration-based), and the
 //!   quantizer that makes the endpoint exact.
 //!
@@ -17,6 +18,7 @@ pub mod device;
 pub mod error;
 pub mod format;
 pub mod io;
+pub mod online;
 pub mod peaks;
 pub mod peer;
 pub mod planner;
