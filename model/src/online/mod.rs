@@ -424,6 +424,11 @@ fn build(
     for d in &mut pieces[..settle] {
         d.ticks += extra;
     }
+    // The tick counter and the closed form's binomials bound a piece (2^40 ticks is 127 days
+    // at 10 µs): longer is refused, never wrapped.
+    if pieces.iter().any(|d| d.ticks >= 1 << 40) {
+        return Err(OnlineError::Overflow);
+    }
     let problem = Problem {
         order: o,
         pieces,
