@@ -48,8 +48,6 @@ pub struct StatusBlock {
     pub reply_overflow: Signal<In, Bit>,
     /// Flag SERVO_OVERRUN.
     pub servo_overrun: Signal<In, Bit>,
-    /// Flag SWAP_PENDING.
-    pub swap_pending: Signal<In, Bit>,
     /// Ticks since the last start.
     pub tick_count: Signal<In, Bits<32>>,
     /// Position in output LSBs (low 32 bits).
@@ -71,7 +69,7 @@ pub struct StatusBlock {
 }
 
 /// The flag ports, by flag.
-const FLAG_PORTS: [(u16, &str); 14] = [
+const FLAG_PORTS: [(u16, &str); 13] = [
     (flag::PLAYING, "playing"),
     (flag::DONE, "done"),
     (flag::CUT, "cut"),
@@ -85,13 +83,12 @@ const FLAG_PORTS: [(u16, &str); 14] = [
     (flag::UART_ERROR, "uart_error"),
     (flag::REPLY_OVERFLOW, "reply_overflow"),
     (flag::SERVO_OVERRUN, "servo_overrun"),
-    (flag::SWAP_PENDING, "swap_pending"),
 ];
 
 const _: () = assert!(FLAG_PORTS.len() == flag::ALL.len());
 
 impl StatusBlock {
-    fn flag_values(&self) -> [bool; 14] {
+    fn flag_values(&self) -> [bool; 13] {
         [
             self.playing.val(),
             self.done.val(),
@@ -106,7 +103,6 @@ impl StatusBlock {
             self.uart_error.val(),
             self.reply_overflow.val(),
             self.servo_overrun.val(),
-            self.swap_pending.val(),
         ]
     }
 }
