@@ -114,21 +114,30 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         },
         ..spec(-0.5, seed000.request.method, f.ts)
     };
+    // The seed 000 move back, replanned on the way: program swaps at random ticks, each
+    // planned online from the state at its tick (docs/PROTOCOL.md, SWAP_AT).
+    let replanned = MoveSpec {
+        replans: 4,
+        replan_seed: 2026,
+        ..spec(-0.5, seed000.request.method, f.ts)
+    };
     let moves = vec![
         spec(12.0 * PI, seed001, f.ts),
         spec(-12.0 * PI, seed001, f.ts),
         spec(0.5, seed000.request.method, f.ts),
         stopped,
+        replanned,
     ];
     let verilog = std::fs::read_to_string(&files.core)?;
     let mut cfg = CosimConfig::fixed(moves);
     cfg.mismatch_vcd = out.join("cosim-mismatch.vcd");
     let r = snapgen_sim::cosim::run(&verilog, &cfg)?;
     println!(
-        "  Verilator co-simulation: {} moves ({} with a controlled stop, {} at rest after it), {} ticks ({} clocks), {} mismatches{}",
+        "  Verilator co-simulation: {} moves ({} with a controlled stop, {} at rest after it; {} program swaps replanning a move at random ticks), {} ticks ({} clocks), {} mismatches{}",
         r.moves,
         r.stopped,
         r.stopped - r.stops_not_at_rest,
+        r.replans,
         r.ticks,
         r.clocks,
         u32::from(r.mismatch.is_some()),
@@ -144,6 +153,10 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     ensure!(
         r.planner_disagreements == 0 && r.stops_not_at_rest == 0,
         "the core did not end where the planner said, or a stop did not end at rest"
+    );
+    ensure!(
+        r.replans > 0 && r.swap_faults() == 0,
+        "no program swap was played, or the core armed a late swap or refused a timely one"
     );
     // The I/O top (UART command interface, axis state machine, limit switches, emergency
     // stop, watchdog) against the device model, under random command streams.

@@ -53,6 +53,30 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     if let Some(m) = &r.mismatch {
         println!("{m}");
     }
+    println!(
+        "replans: {} program swaps played ({} drawn too long; refused by the online planner: {}), {} late swaps refused by the core, {} armed swaps cancelled by a stop{}",
+        r.replans,
+        r.replans_too_long,
+        if r.replans_refused.is_empty() {
+            "none".to_string()
+        } else {
+            r.replans_refused
+                .iter()
+                .map(|(k, n)| format!("{n} {k}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        },
+        r.late_swaps - r.late_swaps_taken,
+        r.swaps_cancelled,
+        if r.swap_faults() > 0 {
+            format!(
+                "; {} late swaps armed and {} timely swaps not armed (must be 0)",
+                r.late_swaps_taken, r.swaps_not_armed
+            )
+        } else {
+            String::new()
+        }
+    );
     if r.planner_disagreements > 0 {
         println!(
             "{} moves ended where the planner did not predict",

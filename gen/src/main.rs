@@ -89,6 +89,10 @@ enum Command {
         /// takes the stop unit's decision, about 130 clocks).
         #[arg(long, default_value_t = snapgen_sim::moves::DEFAULT_STOP_SHARE)]
         stop_share: f64,
+        /// Share of the other moves replanned on the way: 1 to 8 program swaps at random
+        /// ticks, each planned online from the state at its tick (docs/PROTOCOL.md, SWAP_AT).
+        #[arg(long, default_value_t = snapgen_sim::moves::DEFAULT_REPLAN_SHARE)]
+        replan_share: f64,
         /// Dump the whole run's waves to this VCD file.
         #[arg(long)]
         vcd: Option<PathBuf>,
@@ -594,6 +598,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seed,
             order,
             stop_share,
+            replan_share,
             vcd,
             mismatch_vcd,
             bench,
@@ -606,11 +611,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             cfg.mix = order;
             cfg.stop_share = stop_share;
+            cfg.replan_share = replan_share;
             cfg.vcd = vcd;
             cfg.mismatch_vcd = mismatch_vcd;
             cfg.fault = inject_fault.map(|s| parse_fault(&s)).transpose()?;
             let r = hw::cosim(&cfg, bench)?;
-            if r.mismatch.is_some() || r.planner_disagreements > 0 {
+            if r.mismatch.is_some() || r.planner_disagreements > 0 || r.swap_faults() > 0 {
                 return Err(anyhow::Error::new(Mismatched));
             }
         }

@@ -6,6 +6,11 @@
 //! becomes standby with its segment count cleared, so a second start without a new upload
 //! plays nothing.
 //!
+//! `swap` arms a program swap ([`crate::swap_timer`]): on the tick that takes the time base
+//! `ticks` from `swap_last` (its low 32 bits) to `swap_last + 1`, the standby program takes
+//! over from the chain's registers as they are, banks swapping as on a start. A stop request or an abort disarms it;
+//! a start is not taken while one is armed.
+//!
 //! `stop` requests a controlled stop ([`crate::stop_unit`]): the unit latches `stop_jerk` and
 //! `stop_accel` and prepares while the move plays on, the next tick after that takes the stop
 //! (the program is cut there), then the unit feeds the chain until it is at rest, within those
@@ -23,6 +28,7 @@ use crate::program_memory::ProgramMemory;
 use crate::sequencer::Sequencer;
 use crate::sign_extend::CellCentre;
 use crate::stop_unit::StopUnit;
+use crate::swap_timer::{SwapTimer, SWAP_BITS};
 use crate::tick_divider::TickDivider;
 use crate::{
     ADDR_BITS, A_BITS, D_BITS, FRAC, INDEX_BITS, J_BITS, POSITION_BITS, TICK_BITS, V_BITS, X_BITS,
@@ -66,6 +72,11 @@ pub struct MotionCore {
     pub count_enable: Signal<In, Bit>,
     /// Segment count to set.
     pub count_value: Signal<In, Bits<INDEX_BITS>>,
+    /// Arm a program swap (one-clock pulse; see [`crate::swap_timer`]).
+    pub swap: Signal<In, Bit>,
+    /// The low 32 bits of the time base on the old program's last tick: the registers at
+    /// `swap_last + 1` are the new program's start.
+    pub swap_last: Signal<In, Bits<SWAP_BITS>>,
     /// Position register, raw.
     pub x: Signal<Out, Bits<X_BITS>>,
     /// Velocity register, raw.
@@ -105,7 +116,10 @@ pub struct MotionCore {
     pub active_bank: Signal<Out, Bit>,
     /// Segment count of the standby program (0: nothing to start).
     pub standby_count: Signal<Out, Bits<INDEX_BITS>>,
+    /// A program swap is armed.
+    pub swap_pending: Signal<Out, Bit>,
     divider: TickDivider,
+    swap_timer: SwapTimer,
     memory: ProgramMemory,
     sequencer: Sequencer,
     chain: SnapChain,
@@ -118,6 +132,7 @@ pub struct MotionCore {
     ticks_reg: DFF<Bits<64>>,
     read_bank: Signal<Local, Bit>,
     engage: Signal<Local, Bit>,
+    ticks_next: Signal<Local, Bits<64>>,
     count_zero: Constant<Bits<INDEX_BITS>>,
     ticks_zero: Constant<Bits<64>>,
     ticks_one: Constant<Bits<64>>,
@@ -142,6 +157,8 @@ impl Default for MotionCore {
             write_snap: Default::default(),
             count_enable: Default::default(),
             count_value: Default::default(),
+            swap: Default::default(),
+            swap_last: Default::default(),
             x: Default::default(),
             v: Default::default(),
             a: Default::default(),
@@ -161,7 +178,9 @@ impl Default for MotionCore {
             tick: Default::default(),
             active_bank: Default::default(),
             standby_count: Default::default(),
+            swap_pending: Default::default(),
             divider: Default::default(),
+            swap_timer: Default::default(),
             memory: Default::default(),
             sequencer: Default::default(),
             chain: Default::default(),
@@ -174,6 +193,7 @@ impl Default for MotionCore {
             ticks_reg: Default::default(),
             read_bank: Default::default(),
             engage: Default::default(),
+            ticks_next: Default::default(),
             count_zero: Constant::new(0.into()),
             ticks_zero: Constant::new(0.into()),
             ticks_one: Constant::new(1.into()),
@@ -184,8 +204,9 @@ impl Default for MotionCore {
 impl Logic for MotionCore {
     #[hdl_gen]
     fn update(&mut self) {
-        clock!(self, clock, divider, memory, sequencer, chain, stop_unit);
+        clock!(self, clock, divider, memory, sequencer, chain, stop_unit, swap_timer);
         dff_setup!(self, clock, bank, count0, count1, aborted_reg, ticks_reg);
+        self.ticks_next.next = self.ticks_reg.q.val() + self.ticks_one.val();
         self.divider.reset.next = self.reset.val();
         self.divider.divisor.next = self.tick_div.val();
         // A due tick waits while the stop unit computes the next tick's snap.
@@ -195,8 +216,19 @@ impl Logic for MotionCore {
             & self.stop_unit.armed.val()
             & !self.reset.val()
             & !self.abort_move.val();
-        // While playing, read the active bank; while idle, the standby bank (the next start's).
-        self.read_bank.next = self.bank.q.val() ^ !self.sequencer.busy.val();
+        // The swap timer: a stop request or an abort disarms it.
+        self.swap_timer.reset.next = self.reset.val();
+        self.swap_timer.cancel.next = self.abort_move.val() | self.stop.val();
+        self.swap_timer.stopping.next = self.stop_unit.active.val();
+        self.swap_timer.arm.next = self.swap.val();
+        self.swap_timer.arm_last.next = self.swap_last.val();
+        self.swap_timer.tick.next = self.divider.tick.val();
+        self.swap_timer.ticks_next.next = self.ticks_next.val().get_bits::<SWAP_BITS>(0);
+        self.sequencer.swap.next = self.swap_timer.due.val();
+        // While playing, read the active bank; while idle or swapping, the standby bank (the
+        // next program's).
+        self.read_bank.next =
+            self.bank.q.val() ^ (!self.sequencer.busy.val() | self.swap_timer.due.val());
         self.memory.read_bank.next = self.read_bank.val();
         self.memory.read_address.next = self.sequencer.address.val();
         if self.read_bank.val() {
@@ -212,8 +244,9 @@ impl Logic for MotionCore {
         self.memory.write_snap.next = self.write_snap.val();
         self.sequencer.reset.next = self.reset.val();
         self.sequencer.tick.next = self.divider.tick.val();
-        // No start while a stop is requested or runs.
-        self.sequencer.start.next = self.start.val() & !self.stop_unit.active.val();
+        // No start while a stop is requested or runs, or a swap is armed.
+        self.sequencer.start.next =
+            self.start.val() & !self.stop_unit.active.val() & !self.swap_timer.pending.val();
         self.sequencer.abort_move.next = self.abort_move.val();
         self.sequencer.engage.next = self.engage.val();
         // Its ticks count once the stop is taken.
@@ -245,14 +278,14 @@ impl Logic for MotionCore {
         if self.reset.val() {
             self.ticks_reg.d.next = self.ticks_zero.val();
         } else if self.divider.tick.val() {
-            self.ticks_reg.d.next = self.ticks_reg.q.val() + self.ticks_one.val();
+            self.ticks_reg.d.next = self.ticks_next.val();
         }
         if self.reset.val() {
             self.bank.d.next = false;
             self.count0.d.next = self.count_zero.val();
             self.count1.d.next = self.count_zero.val();
             self.aborted_reg.d.next = false;
-        } else if self.sequencer.started.val() {
+        } else if self.sequencer.started.val() | self.swap_timer.due.val() {
             // Swap: the standby bank plays; the old active bank becomes standby, emptied.
             self.bank.d.next = !self.bank.q.val();
             self.aborted_reg.d.next = false;
@@ -299,6 +332,7 @@ impl Logic for MotionCore {
         } else {
             self.standby_count.next = self.count1.q.val();
         }
+        self.swap_pending.next = self.swap_timer.pending.val();
     }
 }
 

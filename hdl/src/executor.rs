@@ -94,6 +94,10 @@ pub struct Executor {
     pub servo_overrun_in: Signal<In, Bit>,
     /// The parameter whose value `read_value` gives (the reply transmitter's head).
     pub read_param: Signal<In, Bits<8>>,
+    /// Core: the time base (ticks since reset).
+    pub ticks: Signal<In, Bits<64>>,
+    /// Core: a program swap is armed.
+    pub swap_pending: Signal<In, Bit>,
     /// Core: write one segment.
     pub write_enable: Signal<Out, Bit>,
     /// Core: segment address.
@@ -108,6 +112,10 @@ pub struct Executor {
     pub count_value: Signal<Out, Bits<INDEX_BITS>>,
     /// Core: start.
     pub start: Signal<Out, Bit>,
+    /// Core: arm a program swap for the tick after `swap_last`.
+    pub swap: Signal<Out, Bit>,
+    /// Core: the low 32 bits of the swap's tick minus one.
+    pub swap_last: Signal<Out, Bits<32>>,
     /// Core: controlled stop.
     pub stop: Signal<Out, Bit>,
     /// Core: abort (the emergency stop, a following error).
@@ -223,6 +231,8 @@ impl Executor {
             following_fault: Default::default(),
             servo_overrun_in: Default::default(),
             read_param: Default::default(),
+            ticks: Default::default(),
+            swap_pending: Default::default(),
             write_enable: Default::default(),
             write_address: Default::default(),
             write_ticks: Default::default(),
@@ -230,6 +240,8 @@ impl Executor {
             count_enable: Default::default(),
             count_value: Default::default(),
             start: Default::default(),
+            swap: Default::default(),
+            swap_last: Default::default(),
             stop: Default::default(),
             abort_move: Default::default(),
             load: Default::default(),
@@ -325,6 +337,8 @@ impl Logic for Executor {
                 limit_positive: self.limit_pos.val(),
                 limit_negative: self.limit_neg.val(),
                 emergency_stop: self.estop.val(),
+                ticks: self.ticks.val().to_u64(),
+                swap_pending: self.swap_pending.val(),
             };
             self._sim.model.clock(&i);
         }
@@ -337,6 +351,8 @@ impl Logic for Executor {
         self.count_enable.next = o.count_enable;
         self.count_value.next = u64::from(o.count_value).into();
         self.start.next = o.start;
+        self.swap.next = o.swap;
+        self.swap_last.next = u64::from(o.swap_last).into();
         self.stop.next = o.stop;
         self.abort_move.next = o.abort;
         self.load.next = o.load;
@@ -386,6 +402,8 @@ impl Logic for Executor {
         self.count_enable.connect();
         self.count_value.connect();
         self.start.connect();
+        self.swap.connect();
+        self.swap_last.connect();
         self.stop.connect();
         self.abort_move.connect();
         self.load.connect();
@@ -561,6 +579,7 @@ wire [103:0] seg_snap = {seg_snap};
 wire [7:0] arg0 = payload[7:0];                  // the byte of a one-byte payload
 wire [7:0] cfg_param = {cfg_param};
 wire [103:0] cfg_value = {cfg_value};
+wire [63:0] swap_tick = {swap_tick};
 
 // ---- The command table: known, payload length, has an effect (a retry is not executed) --------
 reg known;
@@ -615,6 +634,8 @@ reg [103:0] write_snap_q = 104'd0, n_write_snap;
 reg count_enable_q = 1'b0, n_count_enable;
 reg [5:0] count_value_q = 6'd0, n_count_value;
 reg start_q = 1'b0, n_start;
+reg swap_q = 1'b0, n_swap;
+reg [31:0] swap_last_q = 32'd0, n_swap_last;
 reg stop_q = 1'b0, n_stop;
 reg abort_q = 1'b0, n_abort;
 reg reply_q = 1'b0, n_reply;
@@ -650,23 +671,46 @@ wire jerk_pair_valid = (cfg_value != 104'd0) && (cfg_value <= stop_accel_q);
 wire accel_pair_valid = (stop_jerk_q != 104'd0) && (stop_jerk_q <= cfg_value);
 wire cfg_pair_valid = (cfg_param == {p_stop_jerk}) ? jerk_pair_valid
    : ((cfg_param == {p_stop_accel}) ? accel_pair_valid : 1'b1);
+// SWAP_AT: how far its tick lies beyond the time base (signed, wrap-safe), registered every
+// clock (the payload is complete a byte before the frame is): one clock old when the frame is
+// executed, and the core arms one clock later, so the time base may have ticked twice by then;
+// the core wants three ticks of lead.
+reg [63:0] swap_lead_q = 64'd0;
+always @(posedge clock) swap_lead_q <= reset ? 64'd0 : (swap_tick - ticks);
+wire swap_late = swap_lead_q[63] || (swap_lead_q < 64'd{min_lead});
+wire swap_far = !swap_lead_q[63] && (swap_lead_q[62:31] != 32'd0);   // the core compares 32 bits
+wire [31:0] swap_before = swap_tick[31:0] - 32'd1;   // the core's swap_last: T − 1, low bits
+wire toward_limit = (first_pos_q && limit_pos) || (first_neg_q && limit_neg);
 reg [7:0] reason;
 always @(*) begin
    reason = 8'd0;
    case (cmd)
    CMD_LOAD_SEGMENT:
       if ((seg_index >= MAX_SEGMENTS) || (seg_ticks == 32'd0)) reason = {r_bad_argument};
+      else if (swap_pending) reason = {r_swap_pending};
    CMD_COMMIT:
       if (arg0 > MAX_SEGMENTS) reason = {r_bad_argument};
+      else if (swap_pending) reason = {r_swap_pending};
    CMD_START:
       if (state_q == {s_disabled}) reason = {r_not_enabled};
       else if (state_q == {s_error}) reason = {r_axis_error};
       else if (state_q == {s_stopping}) reason = {r_stopping};
       else if (busy) reason = {r_busy};
       else if (stopping) reason = {r_stopping};
+      else if (swap_pending) reason = {r_swap_pending};
       else if (standby_count == 6'd0) reason = {r_no_program};
       else if (!at_rest) reason = {r_busy};
-      else if ((first_pos_q && limit_pos) || (first_neg_q && limit_neg)) reason = {r_limit};
+      else if (toward_limit) reason = {r_limit};
+   CMD_SWAP_AT:
+      if (swap_far) reason = {r_bad_argument};
+      else if (state_q == {s_disabled}) reason = {r_not_enabled};
+      else if (state_q == {s_error}) reason = {r_axis_error};
+      else if (state_q == {s_stopping}) reason = {r_stopping};
+      else if (stopping) reason = {r_stopping};
+      else if (swap_pending) reason = {r_swap_pending};
+      else if (standby_count == 6'd0) reason = {r_no_program};
+      else if (swap_late) reason = {r_late};
+      else if (at_rest && !busy && toward_limit) reason = {r_limit};
    CMD_STOP:
       if (state_q == {s_disabled}) reason = {r_not_enabled};
    CMD_HALT:
@@ -697,7 +741,7 @@ end
 wire retry = has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
    && (crc == last_crc_q);
 wire expired = (watchdog_ms_q != 32'd0) && (watchdog_count_q >= watchdog_ms_q);
-wire settling = start_q || stop_q;               // a start or stop the core takes now
+wire settling = start_q || stop_q || swap_q;     // a start, stop or swap the core takes now
 wire driven = busy || stopping;
 
 // ---- Next state, in the model's order ------------------------------------------------------
@@ -706,6 +750,8 @@ always @(*) begin
    n_write_enable = 1'b0;
    n_count_enable = 1'b0;
    n_start = 1'b0;
+   n_swap = 1'b0;
+   n_swap_last = swap_last_q;
    n_stop = 1'b0;
    n_abort = 1'b0;
    n_reply = 1'b0;
@@ -840,6 +886,14 @@ always @(*) begin
             n_first_pos = 1'b0;
             n_first_neg = 1'b0;
          end
+         CMD_SWAP_AT: begin
+            n_swap = 1'b1;
+            n_swap_last = swap_before;
+            n_state = {s_discrete};
+            // The banks swap at the tick; no upload is taken before that.
+            n_first_pos = 1'b0;
+            n_first_neg = 1'b0;
+         end
          CMD_STOP:
             if (state_q != {s_error}) begin
                n_stop = 1'b1;
@@ -892,7 +946,8 @@ always @(*) begin
    // moving: a controlled stop into ErrorStop), then the errors (the emergency stop last: it
    // overrides everything).
    if (((n_state == {s_discrete}) || (n_state == {s_continuous}) || (n_state == {s_stopping}))
-         && (state_q == n_state) && !busy && !stopping && !settling) begin
+         && (state_q == n_state) && !busy && !stopping && !settling
+         && !(at_rest && swap_pending)) begin   // a swap armed at rest: a start to come
       if (at_rest) n_state = {s_standstill};
       else begin
          n_stop = 1'b1;
@@ -920,6 +975,7 @@ always @(*) begin
       n_abort = 1'b1;
       n_stop = 1'b0;
       n_start = 1'b0;
+      n_swap = 1'b0;
       n_amplifier = 1'b0;
       n_state = {s_error};
       n_error = {e_following};
@@ -928,6 +984,7 @@ always @(*) begin
       n_abort = 1'b1;
       n_stop = 1'b0;
       n_start = 1'b0;
+      n_swap = 1'b0;
       n_amplifier = 1'b0;
       n_state = {s_error};
       n_error = {e_estop};
@@ -956,6 +1013,8 @@ always @(posedge clock) begin
       count_enable_q <= 1'b0;
       count_value_q <= 6'd0;
       start_q <= 1'b0;
+      swap_q <= 1'b0;
+      swap_last_q <= 32'd0;
       stop_q <= 1'b0;
       abort_q <= 1'b0;
       reply_q <= 1'b0;
@@ -994,6 +1053,8 @@ always @(posedge clock) begin
       count_enable_q <= n_count_enable;
       count_value_q <= n_count_value;
       start_q <= n_start;
+      swap_q <= n_swap;
+      swap_last_q <= n_swap_last;
       stop_q <= n_stop;
       abort_q <= n_abort;
       reply_q <= n_reply;
@@ -1023,6 +1084,8 @@ always @(*) begin
    count_enable = count_enable_q;
    count_value = count_value_q;
    start = start_q;
+   swap = swap_q;
+   swap_last = swap_last_q;
    stop = stop_q;
    abort_move = abort_q;
    load = load_q;
@@ -1060,6 +1123,12 @@ end
         seg_snap = protocol_v::received_field("payload", n_seg, 5, 13),
         cfg_param = protocol_v::received_field("payload", n_cfg, 0, 1),
         cfg_value = protocol_v::received_field("payload", n_cfg, 1, 13),
+        swap_tick = protocol_v::received_field(
+            "payload",
+            spec(snapgen_model::protocol::code::SWAP_AT).len as usize,
+            0,
+            8
+        ),
         table = table,
         known_param = known_param.join(" || "),
         over = over,
@@ -1097,6 +1166,9 @@ end
         r_not_configured = r(Reason::NotConfigured),
         r_limit = r(Reason::Limit),
         r_not_disabled = r(Reason::NotDisabled),
+        r_late = r(Reason::Late),
+        min_lead = snapgen_model::io::executor::SWAP_MIN_LEAD,
+        r_swap_pending = r(Reason::SwapPending),
         p_stop_jerk = param_name(Param::StopJerk),
         p_stop_accel = param_name(Param::StopAccel),
         p_telemetry = param_name(Param::TelemetryPeriod),

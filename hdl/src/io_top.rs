@@ -303,6 +303,8 @@ impl Logic for IoTop {
         self.exec.busy.next = self.core.busy.val();
         self.exec.stopping.next = self.core.stopping.val();
         self.exec.standby_count.next = self.core.standby_count.val();
+        self.exec.ticks.next = self.core.ticks.val();
+        self.exec.swap_pending.next = self.core.swap_pending.val();
         self.exec.tick.next = self.core.tick.val();
         self.exec.at_rest.next = self.core.at_rest.val();
         self.exec.encoder_errors.next = self.encoder.errors.val();
@@ -319,6 +321,8 @@ impl Logic for IoTop {
         self.core.reset.next = self.reset.val();
         self.core.tick_div.next = self.exec.tick_div.val();
         self.core.start.next = self.exec.start.val();
+        self.core.swap.next = self.exec.swap.val();
+        self.core.swap_last.next = self.exec.swap_last.val();
         self.core.abort_move.next = self.exec.abort_move.val();
         self.core.stop.next = self.exec.stop.val();
         self.core.load.next = self.exec.load.val();
@@ -355,6 +359,7 @@ impl Logic for IoTop {
         self.status_block.uart_error.next = self.exec.uart_error.val();
         self.status_block.reply_overflow.next = self.exec.reply_overflow.val();
         self.status_block.servo_overrun.next = self.exec.servo_overrun.val();
+        self.status_block.swap_pending.next = self.core.swap_pending.val();
         self.status_block.following_peak.next = self.servo.peak.val();
         self.status_block.duty.next = self.servo.duty.val();
         self.status_block.tick_count.next = self.core.tick_count.val();

@@ -40,6 +40,7 @@ pub mod sign_extend;
 pub mod sim_bits;
 pub mod status_block;
 pub mod stop_unit;
+pub mod swap_timer;
 pub mod tick_divider;
 pub mod uart_rx;
 pub mod uart_tx;
@@ -96,8 +97,11 @@ pub(crate) mod synth_check {
     pub fn synth_block<U: Block>(name: &str, uut: U) -> String {
         let top = format!("snapgen_{name}");
         let mut waivers = crate::verilog::SEQUENCER_HINTS.to_vec();
-        if name == "io_top" {
-            waivers = crate::verilog::io_top_waivers();
+        match name {
+            "io_top" => waivers = crate::verilog::io_top_waivers(),
+            "motion_core" => waivers = crate::verilog::core_waivers(),
+            "swap_timer" => waivers.push(crate::verilog::SWAP_TIMER_WAIVER),
+            _ => {}
         }
         let verilog = crate::verilog::block_verilog(uut, &top, &waivers)
             .unwrap_or_else(|e| panic!("{name}: {e}"));

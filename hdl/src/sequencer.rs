@@ -6,6 +6,10 @@
 //! raises `done`. A start is accepted only while idle; an abort stops it at once. The first
 //! program tick is the first tick strictly after the clock that accepted the start.
 //!
+//! A program swap (`swap`, on a tick, from [`crate::swap_timer`]) loads segment 0 of the
+//! program being read (the standby bank's, at address 0) in place of the tick's usual step,
+//! busy or not, so the next tick is the new program's first.
+//!
 //! When a controlled stop is taken (`engage`, on a tick) the program is cut there: busy and
 //! done fall and the snap drops to 0 (the stop unit feeds the chain from the next tick). The
 //! tick counter counts every tick while a program plays or a stop runs (`stopping`).
@@ -27,6 +31,8 @@ pub struct Sequencer {
     pub start: Signal<In, Bit>,
     /// Stop now.
     pub abort_move: Signal<In, Bit>,
+    /// A program swap is due on this clock's tick: load segment 0 (read at address 0).
+    pub swap: Signal<In, Bit>,
     /// A controlled stop is taken on this clock's tick: cut the program.
     pub engage: Signal<In, Bit>,
     /// A controlled stop runs (its ticks are counted).
@@ -37,7 +43,8 @@ pub struct Sequencer {
     pub entry_ticks: Signal<In, Bits<TICK_BITS>>,
     /// Memory read data at `address`: snap.
     pub entry_snap: Signal<In, Bits<D_BITS>>,
-    /// Memory read address within the bank: the next segment while busy, 0 while idle.
+    /// Memory read address within the bank: the next segment while busy, 0 while idle or
+    /// swapping.
     pub address: Signal<Out, Bits<ADDR_BITS>>,
     /// Snap for this tick (0 while idle).
     pub snap: Signal<Out, Bits<D_BITS>>,
@@ -75,6 +82,7 @@ impl Default for Sequencer {
             tick: Default::default(),
             start: Default::default(),
             abort_move: Default::default(),
+            swap: Default::default(),
             engage: Default::default(),
             stopping: Default::default(),
             count: Default::default(),
@@ -118,7 +126,7 @@ impl Logic for Sequencer {
             tick_count_reg
         );
         self.next_index.next = self.index_reg.q.val() + self.index_one.val();
-        if self.busy_reg.q.val() {
+        if self.busy_reg.q.val() & !self.swap.val() {
             self.address.next = self.next_index.val().get_bits::<ADDR_BITS>(0);
         } else {
             self.address.next = self.address_zero.val();
@@ -151,7 +159,20 @@ impl Logic for Sequencer {
             if self.busy_reg.q.val() | self.stopping.val() {
                 self.tick_count_reg.d.next = self.tick_count_reg.q.val() + self.ticks_one.val();
             }
-            if self.engage.val() {
+            if self.swap.val() {
+                self.index_reg.d.next = self.index_zero.val();
+                self.tick_count_reg.d.next = self.ticks_zero.val();
+                if self.count.val() == self.index_zero.val() {
+                    self.busy_reg.d.next = false;
+                    self.done_reg.d.next = true;
+                    self.snap_reg.d.next = self.snap_zero.val();
+                } else {
+                    self.busy_reg.d.next = true;
+                    self.done_reg.d.next = false;
+                    self.left.d.next = self.entry_ticks.val();
+                    self.snap_reg.d.next = self.entry_snap.val();
+                }
+            } else if self.engage.val() {
                 self.busy_reg.d.next = false;
                 self.done_reg.d.next = false;
                 self.snap_reg.d.next = self.snap_zero.val();

@@ -48,6 +48,8 @@ pub struct StatusBlock {
     pub reply_overflow: Signal<In, Bit>,
     /// Flag SERVO_OVERRUN.
     pub servo_overrun: Signal<In, Bit>,
+    /// Flag SWAP_PENDING.
+    pub swap_pending: Signal<In, Bit>,
     /// Ticks since the last start.
     pub tick_count: Signal<In, Bits<32>>,
     /// Position in output LSBs (low 32 bits).
@@ -69,7 +71,7 @@ pub struct StatusBlock {
 }
 
 /// The flag ports, by flag.
-const FLAG_PORTS: [(u16, &str); 13] = [
+const FLAG_PORTS: [(u16, &str); 14] = [
     (flag::PLAYING, "playing"),
     (flag::DONE, "done"),
     (flag::CUT, "cut"),
@@ -83,12 +85,13 @@ const FLAG_PORTS: [(u16, &str); 13] = [
     (flag::UART_ERROR, "uart_error"),
     (flag::REPLY_OVERFLOW, "reply_overflow"),
     (flag::SERVO_OVERRUN, "servo_overrun"),
+    (flag::SWAP_PENDING, "swap_pending"),
 ];
 
 const _: () = assert!(FLAG_PORTS.len() == flag::ALL.len());
 
 impl StatusBlock {
-    fn flag_values(&self) -> [bool; 13] {
+    fn flag_values(&self) -> [bool; 14] {
         [
             self.playing.val(),
             self.done.val(),
@@ -103,6 +106,7 @@ impl StatusBlock {
             self.uart_error.val(),
             self.reply_overflow.val(),
             self.servo_overrun.val(),
+            self.swap_pending.val(),
         ]
     }
 }

@@ -4,7 +4,7 @@
 //! README's test command installs it).
 
 use rust_hdl::prelude::*;
-use snapgen_hdl::verilog::{block_verilog, Waiver, SEQUENCER_HINTS};
+use snapgen_hdl::verilog::{block_verilog, Waiver, SEQUENCER_HINTS, SWAP_TIMER_WAIVER};
 
 fn lint<U: Block>(name: &str, uut: U, extra: &[Waiver]) {
     let top = format!("snapgen_{name}");
@@ -30,7 +30,16 @@ fn lint<U: Block>(name: &str, uut: U, extra: &[Waiver]) {
 
 #[test]
 fn every_block_lints_clean() {
-    lint("motion_core", snapgen_hdl::core::MotionCore::default(), &[]);
+    lint(
+        "motion_core",
+        snapgen_hdl::core::MotionCore::default(),
+        &[SWAP_TIMER_WAIVER],
+    );
+    lint(
+        "swap_timer",
+        snapgen_hdl::swap_timer::SwapTimer::default(),
+        &[SWAP_TIMER_WAIVER],
+    );
     lint(
         "quadrature",
         snapgen_hdl::quadrature::QuadratureDecoder::<32>::default(),

@@ -31,6 +31,15 @@
 //! * `at_rest` is v = a = j = 0; `heading` (registered) is the sign of the first non-zero of
 //!   v, a, j: where the axis goes next (a move from rest heads somewhere from its first tick).
 //! * Writes go to the standby bank.
+//! * `swap` arms a **program swap** for the tick T = `swap_last + 1` (low 32 bits of the time
+//!   base): the tick that brings `ticks` from `swap_last` to T is still the old program's (or
+//!   the idle chain's), and on it the sequencer loads segment 0 of the standby bank, as a start
+//!   does, so the tick from T to T + 1 is the new program's first: the new program starts from
+//!   the registers at T, as they are (nothing is reset). An arm is taken only when
+//!   `swap_last − (ticks + 1) − 1`, modulo 2^32, is below 2^31 (with `ticks` before the
+//!   edge: T lies 3 to 2^31 + 2 ticks ahead; wrap-safe), not while a stop is requested or
+//!   runs, and not with a swap already armed; otherwise it changes nothing. A stop request, an abort or a reset cancels
+//!   an armed swap; a start is not taken while one is armed.
 
 use crate::chain::{wrap, ChainState};
 use crate::format::{Format, Widths, FRAC_BITS};
@@ -71,6 +80,11 @@ pub struct CoreInputs {
     pub count_enable: bool,
     /// Segment count (0..=32).
     pub count_value: u8,
+    /// Arm a program swap for the tick after `swap_last`.
+    pub swap: bool,
+    /// The low 32 bits of the time base on the old program's last tick (T − 1, where the
+    /// state at T is the new program's start).
+    pub swap_last: u32,
 }
 
 /// The core's outputs after a clock edge.
@@ -113,6 +127,8 @@ pub struct CoreOutputs {
     pub active_bank: bool,
     /// Segment count of the standby program.
     pub standby_count: u8,
+    /// A program swap is armed.
+    pub swap_pending: bool,
 }
 
 /// Where the stop unit is.
@@ -159,6 +175,8 @@ pub struct CoreModel {
     stop_law: Option<StopLaw>,
     stop_over: bool,
     heading: i8,
+    swap_pending: bool,
+    swap_last: u32,
 }
 
 impl CoreModel {
@@ -189,6 +207,8 @@ impl CoreModel {
             stop_law: None,
             stop_over: false,
             heading: 0,
+            swap_pending: false,
+            swap_last: 0,
         }
     }
 
@@ -233,9 +253,17 @@ impl CoreModel {
         let w = self.widths;
         // Combinational values before the edge.
         let tick = self.tick_now(i.tick_div);
-        let read_bank = usize::from(self.bank ^ !self.busy);
+        // The armed swap is due on this tick: the state after it is the new program's start.
+        let due = self.swap_pending
+            && tick
+            && self.ticks as u32 == self.swap_last
+            && !i.reset
+            && !i.abort
+            && !i.stop;
+        let fetch_first = !self.busy || due;
+        let read_bank = usize::from(self.bank ^ fetch_first);
         let count = self.counts[read_bank];
-        let address = if self.busy {
+        let address = if !fetch_first {
             usize::from(self.index.wrapping_add(1)) % BANK_DEPTH
         } else {
             0
@@ -250,7 +278,8 @@ impl CoreModel {
             StopPhase::Init(_) | StopPhase::Decide(_) | StopPhase::Ready(_)
         );
         let old_busy = self.busy;
-        let started = !i.reset && !i.abort && i.start && !self.busy && !stopping;
+        let started =
+            !i.reset && !i.abort && i.start && !self.busy && !stopping && !self.swap_pending;
         let chain_snap = match self.stop_phase {
             StopPhase::Ready(d) => d,
             _ => self.snap,
@@ -286,7 +315,21 @@ impl CoreModel {
             if self.busy || engaged {
                 self.tick_count = self.tick_count.wrapping_add(1);
             }
-            if engage {
+            if due {
+                // The swap: segment 0 of the standby program from the next tick on.
+                self.index = 0;
+                self.tick_count = 0;
+                if count == 0 {
+                    self.busy = false;
+                    self.done = true;
+                    self.snap = 0;
+                } else {
+                    self.busy = true;
+                    self.done = false;
+                    self.left = entry_ticks;
+                    self.snap = entry_snap;
+                }
+            } else if engage {
                 // The stop takes the program's place from the next tick.
                 self.busy = false;
                 self.done = false;
@@ -306,6 +349,19 @@ impl CoreModel {
                     self.left = self.left.wrapping_sub(1);
                 }
             }
+        }
+
+        // The swap timer: armed only for a tick at least three ahead of the time base before
+        // this edge; cancelled by a stop request, an abort or a reset; spent when due.
+        let lead = i
+            .swap_last
+            .wrapping_sub((self.ticks as u32).wrapping_add(1))
+            .wrapping_sub(1);
+        if i.reset || i.abort || i.stop || due {
+            self.swap_pending = false;
+        } else if i.swap && !self.swap_pending && !stopping && lead < 1 << 31 {
+            self.swap_pending = true;
+            self.swap_last = i.swap_last;
         }
 
         // The time base: every tick since reset.
@@ -396,7 +452,7 @@ impl CoreModel {
             self.bank = false;
             self.counts = [0; 2];
             self.aborted = false;
-        } else if started {
+        } else if started || due {
             self.bank = !old_bank;
             self.aborted = false;
             self.counts[usize::from(old_bank)] = 0;
@@ -446,6 +502,7 @@ impl CoreModel {
             heading: self.heading,
             active_bank: self.bank,
             standby_count: self.counts[usize::from(!self.bank)],
+            swap_pending: self.swap_pending,
         }
     }
 }
@@ -665,5 +722,166 @@ mod tests {
         });
         assert!(!o.busy && !o.stopping && o.aborted);
         assert_eq!(m.chain(), ChainState::at_rest(x));
+    }
+
+    /// A swap armed for tick T mid-move: the old program plays up to T, the new one from the
+    /// registers at T (nothing reset), and the chain equals the old program's first T − t0
+    /// ticks followed by the whole new program, stepped independently.
+    #[test]
+    fn a_swap_continues_from_the_registers_at_its_tick() {
+        let f = DEFAULT_FORMAT;
+        let old = Program {
+            segments: vec![
+                Segment { ticks: 40, snap: 9 },
+                Segment {
+                    ticks: 40,
+                    snap: -9,
+                },
+            ],
+        };
+        let new = Program {
+            segments: vec![
+                Segment { ticks: 3, snap: -4 },
+                Segment { ticks: 5, snap: 2 },
+            ],
+        };
+        let mut m = reset();
+        load(&mut m, &old);
+        m.clock(&CoreInputs {
+            start: true,
+            ..Default::default()
+        });
+        let t0 = m.outputs().ticks;
+        load(&mut m, &new);
+        let at = m.outputs().ticks + 10;
+        let o = m.clock(&CoreInputs {
+            swap: true,
+            swap_last: (at - 1) as u32,
+            ..Default::default()
+        });
+        assert!(o.swap_pending && o.busy);
+        // Play until the time base reaches T: the state there is the old program's.
+        while m.outputs().ticks < at {
+            m.clock(&CoreInputs::default());
+        }
+        let o = m.outputs();
+        assert!(!o.swap_pending && o.busy && o.segment == 0 && o.tick_count == 0);
+        let head = Program {
+            segments: vec![Segment {
+                ticks: (at - t0) as u32,
+                snap: 9,
+            }],
+        };
+        let at_t = ChainState::at_rest(f.home_raw()).run_program(&head, &f.widths);
+        assert_eq!(m.chain(), at_t);
+        let mut n = 0;
+        while m.busy() {
+            m.clock(&CoreInputs::default());
+            n += 1;
+        }
+        assert_eq!(n, 8);
+        assert_eq!(m.chain(), at_t.run_program(&new, &f.widths));
+        assert_eq!(
+            m.outputs().standby_count,
+            0,
+            "the swap consumed the program"
+        );
+    }
+
+    /// An arm for a tick the time base has reached, or less than three ticks ahead of it
+    /// (before the arming edge), or 2^31 + 3 or more ahead, is not taken: nothing changes, the
+    /// old program plays on and the standby program stays.
+    #[test]
+    fn a_late_swap_changes_nothing() {
+        let old = Program {
+            segments: vec![Segment { ticks: 30, snap: 5 }],
+        };
+        let new = Program {
+            segments: vec![Segment { ticks: 3, snap: -4 }],
+        };
+        // d = T − ticks (before the arming edge): accepted only in 3..2^31 + 3.
+        for d in [-5i64, -1, 0, 1, 2, (1 << 31) + 3, (1 << 32) - 1] {
+            let mut a = reset();
+            load(&mut a, &old);
+            a.clock(&CoreInputs {
+                start: true,
+                ..Default::default()
+            });
+            load(&mut a, &new);
+            let mut b = a.clone();
+            let at = a.outputs().ticks.wrapping_add(d as u64);
+            a.clock(&CoreInputs {
+                swap: true,
+                swap_last: at.wrapping_sub(1) as u32,
+                ..Default::default()
+            });
+            b.clock(&CoreInputs::default());
+            assert_eq!(a.outputs(), b.outputs(), "T − ticks = {d}");
+            while a.busy() {
+                a.clock(&CoreInputs::default());
+                b.clock(&CoreInputs::default());
+                assert_eq!(a.outputs(), b.outputs());
+            }
+            assert_eq!(a.outputs().standby_count, 1);
+        }
+        // The window's ends are taken.
+        for d in [3u64, (1 << 31) + 2] {
+            let mut a = reset();
+            load(&mut a, &new);
+            let at = a.outputs().ticks + d;
+            let o = a.clock(&CoreInputs {
+                swap: true,
+                swap_last: (at - 1) as u32,
+                ..Default::default()
+            });
+            assert!(o.swap_pending, "T − ticks = {d}");
+        }
+    }
+
+    /// A stop request cancels an armed swap: the stop runs, the swap never happens.
+    #[test]
+    fn a_stop_cancels_an_armed_swap() {
+        let old = Program {
+            segments: vec![
+                Segment { ticks: 30, snap: 5 },
+                Segment {
+                    ticks: 30,
+                    snap: -5,
+                },
+            ],
+        };
+        let new = Program {
+            segments: vec![Segment { ticks: 3, snap: -4 }],
+        };
+        let mut m = reset();
+        load(&mut m, &old);
+        m.clock(&CoreInputs {
+            start: true,
+            ..Default::default()
+        });
+        load(&mut m, &new);
+        let at = m.outputs().ticks + 2000;
+        m.clock(&CoreInputs {
+            swap: true,
+            swap_last: (at - 1) as u32,
+            ..Default::default()
+        });
+        let o = m.clock(&CoreInputs {
+            stop: true,
+            stop_limits: StopLimits {
+                jerk: 100,
+                accel: 1000,
+            },
+            ..Default::default()
+        });
+        assert!(!o.swap_pending && o.stopping);
+        while m.outputs().ticks < at + 10 {
+            m.clock(&CoreInputs::default());
+        }
+        assert_eq!(
+            m.outputs().standby_count,
+            1,
+            "the swap never took the program"
+        );
     }
 }

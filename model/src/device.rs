@@ -313,6 +313,8 @@ impl Device {
             emergency_stop: es,
             following_fault: self.servo.outputs().fault,
             servo_overrun: self.servo.outputs().overrun,
+            ticks: core_out.ticks,
+            swap_pending: core_out.swap_pending,
         };
         let core_in = CoreInputs {
             reset,
@@ -329,6 +331,8 @@ impl Device {
             write_snap: exec_out.write_snap,
             count_enable: exec_out.count_enable,
             count_value: exec_out.count_value,
+            swap: exec_out.swap,
+            swap_last: exec_out.swap_last,
         };
         let tx_in = ReplyTxInputs {
             reset,
@@ -421,7 +425,7 @@ mod tests {
     use crate::peer::Peer;
     use crate::planner::{plan_from, Method, MoveRequest};
     use crate::protocol::{
-        flag, AxisState, Command, Decoded, Decoder, ErrorId, Param, Reason, Reply,
+        code, flag, AxisState, Command, Decoded, Decoder, ErrorId, Param, Reason, Reply,
     };
     use crate::stop::StopLimits;
     use crate::ChainState;
@@ -916,5 +920,118 @@ mod tests {
             panic!()
         };
         assert_eq!(st.x, (i128::from(s.encoder) << 80) + (1 << 79));
+    }
+
+    fn state(b: &mut Bench) -> crate::protocol::StateReply {
+        match b.ask(Command::ReadState) {
+            Reply::State(st) => st,
+            r => panic!("{r:?}"),
+        }
+    }
+
+    /// A move started at a known tick by SWAP_AT from rest, replanned mid-move from the state
+    /// the host predicts for a future tick, swapped there over the wire: it lands exactly where
+    /// the online plan says. A late SWAP_AT, uploads and a second SWAP_AT while one is armed
+    /// are refused and change nothing.
+    #[test]
+    fn a_replan_swaps_in_at_its_tick_over_the_wire() {
+        use crate::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
+        use crate::program::Segment;
+        let f = DEFAULT_FORMAT;
+        let w = f.widths;
+        let mut b = Bench::new();
+        b.run(10);
+        let first = plan_from(
+            &MoveRequest {
+                distance: 0.05,
+                method: Method::Order3 {
+                    vmax: 1.0,
+                    amax: 50.0,
+                    jmax: 5e3,
+                },
+            },
+            &f,
+            ChainState::at_rest(f.home_raw()),
+        )
+        .unwrap();
+        powered_with(&mut b, &first.program.segments);
+        // From rest, at a tick the host chooses: it knows where the program begins.
+        let st = state(&mut b);
+        let from = ChainState::at_rest(st.x);
+        assert_eq!((st.v, st.a, st.j), (0, 0, 0));
+        // A STATE reply takes 1340 ticks on this wire, a SWAP_AT 280: lead by more.
+        let begin = st.ticks + 4000;
+        let c = Command::SwapAt { tick: begin };
+        assert_eq!(b.ask(c), ack(&c));
+        let s = b.status();
+        assert!(s.has(flag::SWAP_PENDING) && !s.has(flag::PLAYING));
+        assert_eq!(s.state, AxisState::DiscreteMotion as u8);
+        let one = Command::LoadSegment {
+            index: 0,
+            segment: Segment { ticks: 1, snap: 1 },
+        };
+        assert_eq!(b.ask(one), nak(code::LOAD_SEGMENT, Reason::SwapPending));
+        let again = Command::SwapAt { tick: begin + 1 };
+        assert_eq!(b.ask(again), nak(code::SWAP_AT, Reason::SwapPending));
+        while !b.status().has(flag::PLAYING) {}
+        // Mid-move: replan from the state at a future tick, predicted by the host.
+        let st = state(&mut b);
+        assert!(st.ticks > begin);
+        let at = st.ticks + 40_000;
+        let predicted = from.after_ticks(&first.program, at - begin, &w);
+        let cell = f.output_lsb(st.x) - 5_000;
+        let limits = OnlineLimits {
+            velocity: 0.8,
+            acceleration: 40.0,
+            deceleration: 30.0,
+            jerk: 4e3,
+        };
+        let replan = plan_online(
+            &predicted,
+            &OnlineTarget::Position {
+                cell,
+                velocity: 0.0,
+            },
+            &limits,
+            OnlineOrder::Three,
+            &f,
+        )
+        .unwrap();
+        for (k, s) in replan.program.segments.iter().enumerate() {
+            let c = Command::LoadSegment {
+                index: k as u8,
+                segment: *s,
+            };
+            assert_eq!(b.ask(c), ack(&c));
+        }
+        let c = Command::Commit {
+            count: replan.program.segments.len() as u8,
+        };
+        assert_eq!(b.ask(c), ack(&c));
+        let c = Command::SwapAt { tick: at };
+        assert_eq!(b.ask(c), ack(&c));
+        while b.status().has(flag::SWAP_PENDING) {}
+        // Too late: a tick the time base has passed. Refused, and nothing changes.
+        assert_eq!(b.ask(one), ack(&one));
+        let c = Command::Commit { count: 1 };
+        assert_eq!(b.ask(c), ack(&c));
+        let now = state(&mut b).ticks;
+        let late = Command::SwapAt { tick: now };
+        assert_eq!(b.ask(late), nak(code::SWAP_AT, Reason::Late));
+        loop {
+            let s = b.status();
+            if s.state == AxisState::Standstill as u8 {
+                break;
+            }
+            assert_eq!(s.state, AxisState::DiscreteMotion as u8, "{s:?}");
+        }
+        let end = state(&mut b);
+        let want = replan.final_state;
+        assert_eq!(
+            (end.x, end.v, end.a, end.j),
+            (want.x, want.v, want.a, want.j)
+        );
+        assert_eq!(f.output_lsb(end.x), cell);
+        assert_eq!(b.status().flags & flag::SWAP_PENDING, 0);
     }
 }

@@ -27,7 +27,7 @@ pub const START: u8 = 0xA5;
 /// Bytes around the payload: start, length, command, sequence, two CRC bytes.
 pub const OVERHEAD: usize = 6;
 /// Protocol version reported by `PING`.
-pub const PROTOCOL_VERSION: u8 = 3;
+pub const PROTOCOL_VERSION: u8 = 4;
 /// The CRC polynomial (CRC-16/CCITT-FALSE).
 pub const CRC_POLY: u16 = 0x1021;
 /// The CRC's initial value.
@@ -91,6 +91,9 @@ pub mod code {
     pub const POWER: u8 = 0x0B;
     /// Clear an axis error (MC_Reset).
     pub const RESET: u8 = 0x0C;
+    /// Arm a program swap at an absolute tick (the standby program takes over from the
+    /// registers as they are then).
+    pub const SWAP_AT: u8 = 0x0D;
     /// Device → host: identity (reply to `PING`).
     pub const IDENTITY: u8 = 0x41;
     /// Status (reply to `READ_STATUS`).
@@ -124,7 +127,7 @@ pub struct CommandSpec {
 }
 
 /// Every command (docs/PROTOCOL.md, "Commands").
-pub const COMMANDS: [CommandSpec; 12] = [
+pub const COMMANDS: [CommandSpec; 13] = [
     cmd(code::PING, "PING", 0, false, code::IDENTITY),
     cmd(
         code::LOAD_SEGMENT,
@@ -149,6 +152,7 @@ pub const COMMANDS: [CommandSpec; 12] = [
     cmd(code::READ_CONFIG, "READ_CONFIG", 1, false, code::CONFIG),
     cmd(code::POWER, "POWER", 1, true, code::ACK),
     cmd(code::RESET, "RESET", 0, true, code::ACK),
+    cmd(code::SWAP_AT, "SWAP_AT", 8, true, code::ACK),
 ];
 
 const fn cmd(code: u8, name: &'static str, len: u8, effect: bool, reply: u8) -> CommandSpec {
@@ -196,10 +200,14 @@ pub enum Reason {
     Limit = 12,
     /// The parameter can only be set while the axis is Disabled (POWER it off first).
     NotDisabled = 13,
+    /// SWAP_AT for a tick less than five ticks ahead of the time base (replan for a later tick).
+    Late = 14,
+    /// A program swap is armed (wait until its tick has passed).
+    SwapPending = 15,
 }
 
 /// Every NAK reason with its meaning (docs/PROTOCOL.md, "NAK reasons").
-pub const REASONS: [(Reason, &str); 13] = [
+pub const REASONS: [(Reason, &str); 15] = [
     (Reason::BadCrc, "BAD_CRC"),
     (Reason::BadLength, "BAD_LENGTH"),
     (Reason::UnknownCommand, "UNKNOWN_COMMAND"),
@@ -213,6 +221,8 @@ pub const REASONS: [(Reason, &str); 13] = [
     (Reason::NotConfigured, "NOT_CONFIGURED"),
     (Reason::Limit, "LIMIT"),
     (Reason::NotDisabled, "NOT_DISABLED"),
+    (Reason::Late, "LATE"),
+    (Reason::SwapPending, "SWAP_PENDING"),
 ];
 
 impl Reason {
@@ -252,11 +262,13 @@ const fn refusal(command: &'static str, reasons: &'static [Reason], when: &'stat
 
 /// Every refusal a command can get after its length and code are accepted (the frame-level
 /// reasons BAD_CRC, FRAMING, BAD_LENGTH and UNKNOWN_COMMAND apply to any frame).
-pub const REFUSALS: [Refusal; 17] = {
+pub const REFUSALS: [Refusal; 24] = {
     use Reason::*;
     [
         refusal("LOAD_SEGMENT", &[BadArgument], "`index` ≥ 32 or `ticks` = 0"),
+        refusal("LOAD_SEGMENT", &[SwapPending], "a swap is armed"),
         refusal("COMMIT", &[BadArgument], "`count` > 32"),
+        refusal("COMMIT", &[SwapPending], "a swap is armed"),
         refusal(
             "START",
             &[NotEnabled, AxisError, Stopping],
@@ -264,8 +276,8 @@ pub const REFUSALS: [Refusal; 17] = {
         ),
         refusal(
             "START",
-            &[Busy, Stopping, NoProgram],
-            "a program plays, a stop runs, the standby program is empty",
+            &[Busy, Stopping, SwapPending, NoProgram],
+            "a program plays, a stop runs, a swap is armed, the standby program is empty",
         ),
         refusal("START", &[Busy], "the axis is not at rest (v, a or j ≠ 0)"),
         refusal(
@@ -311,6 +323,31 @@ pub const REFUSALS: [Refusal; 17] = {
             "RESET",
             &[AxisError],
             "in ErrorStop while the axis moves or the emergency stop is active",
+        ),
+        refusal(
+            "SWAP_AT",
+            &[BadArgument],
+            "`tick` lies 2^31 ticks or more beyond the time base (the core compares 32 bits)",
+        ),
+        refusal(
+            "SWAP_AT",
+            &[NotEnabled, AxisError, Stopping],
+            "the axis is Disabled, in ErrorStop, Stopping",
+        ),
+        refusal(
+            "SWAP_AT",
+            &[Stopping, SwapPending, NoProgram],
+            "a stop runs, a swap is armed, the standby program is empty",
+        ),
+        refusal(
+            "SWAP_AT",
+            &[Late],
+            "`tick` − (the time base on the clock before the one that executes the command) < 5, as a signed 64-bit difference",
+        ),
+        refusal(
+            "SWAP_AT",
+            &[Limit],
+            "the axis is at rest and segment 0's snap heads toward an active limit switch",
         ),
     ]
 };
@@ -595,9 +632,11 @@ pub mod flag {
     pub const REPLY_OVERFLOW: u16 = 1 << 11;
     /// The controller skipped a sample: it was still computing the last one (since reset).
     pub const SERVO_OVERRUN: u16 = 1 << 12;
+    /// A program swap is armed (SWAP_AT accepted, its tick not yet reached).
+    pub const SWAP_PENDING: u16 = 1 << 13;
 
     /// Every flag with its name.
-    pub const ALL: [(u16, &str); 13] = [
+    pub const ALL: [(u16, &str); 14] = [
         (PLAYING, "PLAYING"),
         (DONE, "DONE"),
         (CUT, "CUT"),
@@ -611,6 +650,7 @@ pub mod flag {
         (UART_ERROR, "UART_ERROR"),
         (REPLY_OVERFLOW, "REPLY_OVERFLOW"),
         (SERVO_OVERRUN, "SERVO_OVERRUN"),
+        (SWAP_PENDING, "SWAP_PENDING"),
     ];
 }
 
@@ -760,6 +800,12 @@ pub enum Command {
     },
     /// Clear an axis error.
     Reset,
+    /// Arm a program swap: the standby program takes over from the registers at absolute
+    /// tick `tick` (a value of the time base, `ticks` in STATE).
+    SwapAt {
+        /// The tick.
+        tick: u64,
+    },
 }
 
 /// Device state.
@@ -1046,6 +1092,7 @@ impl Command {
             Command::ReadConfig { .. } => code::READ_CONFIG,
             Command::Power { .. } => code::POWER,
             Command::Reset => code::RESET,
+            Command::SwapAt { .. } => code::SWAP_AT,
         }
     }
 
@@ -1073,6 +1120,7 @@ impl Command {
             }
             Command::ReadConfig { param } => vec![param as u8],
             Command::Power { on } => vec![u8::from(on)],
+            Command::SwapAt { tick } => tick.to_le_bytes().to_vec(),
             _ => vec![],
         };
         Frame {
@@ -1142,6 +1190,9 @@ impl Command {
                 }
                 Command::Power { on: p[0] == 1 }
             }
+            code::SWAP_AT => Command::SwapAt {
+                tick: u64::from_le_bytes(p[..8].try_into().expect("length checked")),
+            },
             _ => unreachable!("command_spec knows every code handled here"),
         })
     }

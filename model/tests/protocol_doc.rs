@@ -366,6 +366,15 @@ fn examples() -> Vec<Vec<u8>> {
             },
             0,
         ),
+        c(Command::SwapAt { tick: 1_301_000 }, 18),
+        r(Reply::Ack { cmd: code::SWAP_AT }, 18),
+        r(
+            Reply::Nak {
+                cmd: code::SWAP_AT,
+                reason: Reason::Late,
+            },
+            19,
+        ),
     ]
 }
 

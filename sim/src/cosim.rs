@@ -2,9 +2,11 @@
 //!
 //! A session resets the core, then for each move plans it from the model's exact state, writes
 //! its segments into the standby bank, starts it and clocks until it is done (or stops it
-//! midway). Fabric and model receive the same inputs on every clock and every output — x, v,
-//! a, j, position, segment index, busy, done, aborted, tick count, tick, active bank — is
-//! compared after every rising edge. The first mismatch ends the session; it is then re-run
+//! midway, or replans it: a chain of program swaps at random ticks, each planned online from
+//! the state the model predicts for its tick, as a host does). Fabric and model receive the
+//! same inputs on every clock and every output — x, v, a, j, position, segment index, busy,
+//! done, aborted, tick count, tick, active bank, swap pending — is compared after every rising
+//! edge. The first mismatch ends the session; it is then re-run
 //! with a trace build to write the waves around it.
 
 use std::collections::VecDeque;
@@ -14,11 +16,16 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use snapgen_model::{plan_from, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use snapgen_model::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
+use snapgen_model::{
+    plan_from, ChainState, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT,
+};
 
 use crate::build::build;
 use crate::fabric::{Fabric, VcdWindow, CORE_OUTPUTS, OUT_SLOTS, OUT_WORDS};
-use crate::moves::{MoveSpec, MoveStream, OrderMix};
+use crate::moves::{log_uniform, MoveSpec, MoveStream, OrderMix};
 use crate::SimError;
 
 /// Clocks per call into the fabric: its output words (76 bytes a clock) stay in the L1/L2
@@ -77,11 +84,13 @@ pub enum Register {
     TickCount,
     /// Ticks since reset.
     Ticks,
+    /// A program swap is armed.
+    SwapPending,
 }
 
 impl Register {
     /// Every register, in comparison order.
-    pub const ALL: [Register; 19] = [
+    pub const ALL: [Register; 20] = [
         Register::X,
         Register::V,
         Register::A,
@@ -101,6 +110,7 @@ impl Register {
         Register::StandbyCount,
         Register::TickCount,
         Register::Ticks,
+        Register::SwapPending,
     ];
 
     /// Its name (as the Verilog port).
@@ -137,6 +147,7 @@ impl Register {
             Register::StandbyCount => u128::from(o.standby_count),
             Register::TickCount => u128::from(o.tick_count),
             Register::Ticks => u128::from(o.ticks),
+            Register::SwapPending => u128::from(o.swap_pending),
         }
     }
 
@@ -222,6 +233,8 @@ pub struct CosimConfig {
     pub mix: OrderMix,
     /// Share of the moves given a controlled stop at a random clock.
     pub stop_share: f64,
+    /// Share of the other moves replanned on the way (program swaps at random ticks).
+    pub replan_share: f64,
     /// Dump the whole run's waves here.
     pub vcd: Option<PathBuf>,
     /// Where to write the waves around a mismatch.
@@ -247,6 +260,7 @@ impl CosimConfig {
             seed,
             mix: OrderMix::Mixed,
             stop_share: crate::moves::DEFAULT_STOP_SHARE,
+            replan_share: crate::moves::DEFAULT_REPLAN_SHARE,
             vcd: None,
             mismatch_vcd: PathBuf::from("cosim-mismatch.vcd"),
             fault: None,
@@ -313,6 +327,20 @@ pub struct CosimReport {
     pub stops_not_at_rest: usize,
     /// Moves the stream drew but the planner refused or that were too long (skipped).
     pub skipped: usize,
+    /// Program swaps played (online replans from the state at their tick).
+    pub replans: usize,
+    /// Replans the online planner refused, by reason (its error's variant): not played.
+    pub replans_refused: std::collections::BTreeMap<String, usize>,
+    /// Replans longer than the stream keeps (`MAX_MOVE_TICKS`): not played.
+    pub replans_too_long: usize,
+    /// Swaps armed for a tick already reached (each must change nothing).
+    pub late_swaps: usize,
+    /// Late swaps the core armed anyway (must be 0).
+    pub late_swaps_taken: usize,
+    /// Timely swaps the core did not arm (must be 0).
+    pub swaps_not_armed: usize,
+    /// Armed swaps cancelled by a controlled stop before their tick.
+    pub swaps_cancelled: usize,
     /// Clocks compared.
     pub clocks: u64,
     /// Ticks compared (clocks on which the chain stepped with a program or a stop).
@@ -332,6 +360,12 @@ pub struct CosimReport {
 }
 
 impl CosimReport {
+    /// Swaps the core handled against the rules: a late one armed or a timely one not (both
+    /// must be 0).
+    pub fn swap_faults(&self) -> usize {
+        self.late_swaps_taken + self.swaps_not_armed
+    }
+
     /// Ticks per second.
     pub fn ticks_per_second(&self) -> f64 {
         self.ticks as f64 / self.seconds.max(1e-9)
@@ -488,7 +522,7 @@ fn session(
             },
             2,
         )?;
-        let mut stream = MoveStream::new(cfg.seed, cfg.mix, cfg.stop_share);
+        let mut stream = MoveStream::new(cfg.seed, cfg.mix, cfg.stop_share, cfg.replan_share);
         let mut fixed = cfg.fixed.iter().flatten();
         let mut played = 0;
         while played < cfg.moves {
@@ -574,61 +608,23 @@ fn session(
                 report.aborted += 1;
             } else if let Some(after) = spec.stop_after {
                 ls.drive(&idle, after.min(budget))?;
-                let stop = CoreInputs {
-                    stop: true,
-                    stop_limits: spec.stop_limits,
-                    ..idle
-                };
-                ls.drive(&stop, 1)?;
-                report.stopped += 1;
-                // Then until the stop is over: a second request (ignored) or an abort on the
-                // way, and an abort if it runs past MAX_STOP_CLOCKS.
-                let mut clocks = 1u64;
-                let mut again = spec.stop_again_after;
-                let abort = spec.abort_stop_after;
-                while ls.side.model.stopping() || ls.side.pending.stop {
-                    let next = [again, abort, Some(MAX_STOP_CLOCKS)]
-                        .into_iter()
-                        .flatten()
-                        .min()
-                        .unwrap_or(MAX_STOP_CLOCKS);
-                    if clocks < next {
-                        let k = (next - clocks).min(BATCH);
-                        ls.drive(&idle, k)?;
-                        clocks += k;
-                        continue;
-                    }
-                    if again == Some(clocks) {
-                        ls.drive(&stop, 1)?;
-                        again = None;
-                    } else {
-                        ls.drive(
-                            &CoreInputs {
-                                abort: true,
-                                ..idle
-                            },
-                            1,
-                        )?;
-                        if abort == Some(clocks) {
-                            report.stops_aborted += 1;
-                        } else {
-                            report.stops_timed_out += 1;
-                        }
-                        // Past the abort (and the input register): nothing runs any more.
-                        ls.drive(&idle, 1)?;
-                        break;
-                    }
-                    clocks += 1;
-                }
-                let o = ls.side.model.outputs();
-                if o.stop_over {
-                    report.stops_over += 1;
-                }
-                // Wherever the stop began, the chain ends at rest (unless it was aborted,
-                // which also leaves it at rest).
-                if !ls.side.model.chain().is_at_rest() {
-                    report.stops_not_at_rest += 1;
-                }
+                controlled_stop(
+                    &mut ls,
+                    &spec,
+                    &idle,
+                    spec.stop_again_after,
+                    spec.abort_stop_after,
+                    report,
+                )?;
+            } else if spec.replans > 0 {
+                replan_chain(
+                    &mut ls,
+                    &spec,
+                    plan.ticks_total(),
+                    plan.final_state,
+                    &idle,
+                    report,
+                )?;
             } else {
                 let mut left = budget;
                 while ls.side.model.busy() && left > 0 {
@@ -653,6 +649,295 @@ fn session(
     report.clocks = ls.clock;
     report.ticks = ls.ticks;
     result
+}
+
+/// A controlled stop with the move's stop limits, run to its end: a second request (ignored)
+/// `again` clocks after the first and an abort `abort` clocks after it when set, and an abort
+/// if it runs past [`MAX_STOP_CLOCKS`].
+fn controlled_stop(
+    ls: &mut Lockstep,
+    spec: &MoveSpec,
+    idle: &CoreInputs,
+    mut again: Option<u64>,
+    abort: Option<u64>,
+    report: &mut CosimReport,
+) -> Result<(), Mismatch> {
+    let stop = CoreInputs {
+        stop: true,
+        stop_limits: spec.stop_limits,
+        ..*idle
+    };
+    ls.drive(&stop, 1)?;
+    report.stopped += 1;
+    let mut clocks = 1u64;
+    while ls.side.model.stopping() || ls.side.pending.stop {
+        let next = [again, abort, Some(MAX_STOP_CLOCKS)]
+            .into_iter()
+            .flatten()
+            .min()
+            .unwrap_or(MAX_STOP_CLOCKS);
+        if clocks < next {
+            let k = (next - clocks).min(BATCH);
+            ls.drive(idle, k)?;
+            clocks += k;
+            continue;
+        }
+        if again == Some(clocks) {
+            ls.drive(&stop, 1)?;
+            again = None;
+        } else {
+            ls.drive(
+                &CoreInputs {
+                    abort: true,
+                    ..*idle
+                },
+                1,
+            )?;
+            if abort == Some(clocks) {
+                report.stops_aborted += 1;
+            } else {
+                report.stops_timed_out += 1;
+            }
+            // Past the abort (and the input register): nothing runs any more.
+            ls.drive(idle, 1)?;
+            break;
+        }
+        clocks += 1;
+    }
+    let o = ls.side.model.outputs();
+    if o.stop_over {
+        report.stops_over += 1;
+    }
+    // Wherever the stop began, the chain ends at rest (unless it was aborted, which also
+    // leaves it at rest).
+    if !ls.side.model.chain().is_at_rest() {
+        report.stops_not_at_rest += 1;
+    }
+    Ok(())
+}
+
+/// The chain's registers when the time base reaches `at` with nothing else asked of the core:
+/// what a host knows from the model before it plans a swap for that tick.
+fn state_at(side: &ModelSide, idle: &CoreInputs, at: u64) -> ChainState {
+    let mut m = side.model.clone();
+    m.edge(&side.pending);
+    while m.outputs().ticks < at {
+        m.edge(idle);
+    }
+    m.chain()
+}
+
+/// Writes `program` into the standby bank and commits it, one clock a segment.
+fn upload(
+    ls: &mut Lockstep,
+    program: &snapgen_model::Program,
+    idle: &CoreInputs,
+) -> Result<(), Mismatch> {
+    for (k, s) in program.segments.iter().enumerate() {
+        ls.drive(
+            &CoreInputs {
+                write_enable: true,
+                write_address: k as u8,
+                write_ticks: s.ticks,
+                write_snap: s.snap,
+                ..*idle
+            },
+            1,
+        )?;
+    }
+    ls.drive(
+        &CoreInputs {
+            count_enable: true,
+            count_value: program.segments.len() as u8,
+            ..*idle
+        },
+        1,
+    )
+}
+
+/// Drives idle clocks until the model's time base reaches `at` (or `budget` clocks pass).
+fn drive_until_tick(
+    ls: &mut Lockstep,
+    idle: &CoreInputs,
+    at: u64,
+    budget: u64,
+) -> Result<(), Mismatch> {
+    let mut left = budget;
+    while ls.side.model.outputs().ticks < at && left > 0 {
+        let per_tick = u64::from(idle.tick_div) + 1;
+        let k = ((at - ls.side.model.outputs().ticks) * per_tick)
+            .min(BATCH)
+            .min(left);
+        ls.drive(idle, k)?;
+        left -= k;
+    }
+    Ok(())
+}
+
+/// Online limits drawn log-uniformly (unit/s, /s², /s³): each the active one in some replans,
+/// some far below the state a replan starts from.
+fn random_limits(rng: &mut StdRng) -> OnlineLimits {
+    OnlineLimits {
+        velocity: log_uniform(rng, 0.02, 10.0),
+        acceleration: log_uniform(rng, 1.0, 1000.0),
+        deceleration: log_uniform(rng, 1.0, 1000.0),
+        jerk: log_uniform(rng, 50.0, 2e5),
+    }
+}
+
+/// The move's replans: `spec.replans` program swaps at random ticks (mid-jerk, mid-acceleration,
+/// at cruise, after the end), each planned online from the state the model predicts for its
+/// tick to a position at rest, a set velocity or a blend point (the last to a position at
+/// rest), uploaded while the current program plays and armed for that tick; now and then a
+/// late swap (it must change nothing) or a stop while one is armed (it cancels it). At the end
+/// the chain must stand where the last plan said.
+fn replan_chain(
+    ls: &mut Lockstep,
+    spec: &MoveSpec,
+    first_ticks: u64,
+    first_final: ChainState,
+    idle: &CoreInputs,
+    report: &mut CosimReport,
+) -> Result<(), Mismatch> {
+    let mut rng = StdRng::seed_from_u64(spec.replan_seed);
+    let f = Format::with_ts(spec.ts);
+    let per_tick = u64::from(spec.tick_div) + 1;
+    let mut program_ticks = first_ticks;
+    // Where the program playing ends, when it ends at rest.
+    let mut ends_at: Option<ChainState> = Some(first_final);
+    let mut done = 0u8;
+    let mut attempts = 0u32;
+    while done < spec.replans || ends_at.is_none() {
+        attempts += 1;
+        if attempts > 4 * u32::from(spec.replans) + 16 {
+            break;
+        }
+        // A random while into the program playing (or past its end).
+        let wait = log_uniform(&mut rng, 1.0, (program_ticks as f64 * 1.2).max(2.0)) as u64;
+        let now = ls.side.model.outputs().ticks;
+        drive_until_tick(ls, idle, now + wait, (wait + 2) * per_tick + 2)?;
+        let now = ls.side.model.outputs().ticks;
+        if rng.gen_bool(0.05) {
+            // Late: a tick the time base has reached, or reaches on the arming edge. The core
+            // must not arm it (the next upload replaces this program).
+            let one = snapgen_model::Program {
+                segments: vec![snapgen_model::Segment { ticks: 5, snap: 7 }],
+            };
+            upload(ls, &one, idle)?;
+            // (The core wants three ticks of lead over the time base before the arming edge,
+            // which is at least `now`: two or fewer are refused whenever it sees them.)
+            let late_at = ls
+                .side
+                .model
+                .outputs()
+                .ticks
+                .wrapping_add_signed(rng.gen_range(-2..=2));
+            ls.drive(
+                &CoreInputs {
+                    swap: true,
+                    swap_last: late_at.wrapping_sub(1) as u32,
+                    ..*idle
+                },
+                1,
+            )?;
+            ls.drive(idle, 2)?;
+            report.late_swaps += 1;
+            if ls.side.model.outputs().swap_pending {
+                report.late_swaps_taken += 1;
+            }
+            continue;
+        }
+        let last = done + 1 >= spec.replans;
+        let lead = log_uniform(&mut rng, 2.0, 3000.0) as u64;
+        // Room for the upload (at most 34 clocks) before the tick, and the core's lead of 3.
+        let at = now + 40 + lead;
+        let start = state_at(&ls.side, idle, at);
+        let limits = random_limits(&mut rng);
+        let order = if rng.gen_bool(0.7) {
+            OnlineOrder::Three
+        } else {
+            OnlineOrder::Two
+        };
+        let sign = if rng.gen_bool(0.5) { 1 } else { -1 };
+        let cell = f.output_lsb(start.x) + sign * log_uniform(&mut rng, 1.0, 2e6) as i128;
+        let speed = limits.velocity * rng.gen_range(0.05..=1.0);
+        let target = match (last, rng.gen_range(0..5)) {
+            (false, 0) => OnlineTarget::Velocity(f64::from(sign as i32) * speed),
+            (false, 1) => OnlineTarget::Position {
+                cell,
+                velocity: f64::from(sign as i32) * speed,
+            },
+            _ => OnlineTarget::Position {
+                cell,
+                velocity: 0.0,
+            },
+        };
+        let plan = match plan_online(&start, &target, &limits, order, &f) {
+            Ok(p) if p.program.total_ticks() <= MAX_MOVE_TICKS => p,
+            Ok(_) => {
+                report.replans_too_long += 1;
+                continue;
+            }
+            Err(e) => {
+                let kind = format!("{e:?}");
+                let kind = kind
+                    .split(['(', ' ', '{'])
+                    .next()
+                    .unwrap_or("?")
+                    .to_string();
+                *report.replans_refused.entry(kind).or_default() += 1;
+                continue;
+            }
+        };
+        upload(ls, &plan.program, idle)?;
+        ls.drive(
+            &CoreInputs {
+                swap: true,
+                swap_last: (at - 1) as u32,
+                ..*idle
+            },
+            1,
+        )?;
+        // Past the input register: armed.
+        ls.drive(idle, 1)?;
+        if !ls.side.model.outputs().swap_pending {
+            report.swaps_not_armed += 1;
+            continue;
+        }
+        if rng.gen_bool(0.03) {
+            // A stop while the swap is armed cancels it; the stop brings the chain to rest.
+            let before = (at - ls.side.model.outputs().ticks) * per_tick;
+            ls.drive(idle, rng.gen_range(0..before.max(1)))?;
+            controlled_stop(ls, spec, idle, None, None, report)?;
+            report.swaps_cancelled += 1;
+            return Ok(());
+        }
+        drive_until_tick(ls, idle, at, (lead + 45) * per_tick + 4)?;
+        report.replans += 1;
+        done += 1;
+        program_ticks = plan.program.total_ticks();
+        ends_at = match target {
+            OnlineTarget::Position { velocity: 0.0, .. } => Some(plan.final_state),
+            _ => None,
+        };
+    }
+    match ends_at {
+        Some(end) => {
+            let budget = (program_ticks + 2) * per_tick + 2;
+            let mut left = budget;
+            while ls.side.model.busy() && left > 0 {
+                let k = left.min(BATCH);
+                ls.drive(idle, k)?;
+                left -= k;
+            }
+            if ls.side.model.chain() != end {
+                report.planner_disagreements += 1;
+            }
+        }
+        // Still moving (no rest target could be planned): the fabric's stop brings it to rest.
+        None => controlled_stop(ls, spec, idle, None, None, report)?,
+    }
+    Ok(())
 }
 
 fn progress_bar(cfg: &CosimConfig) -> ProgressBar {
@@ -734,6 +1019,15 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
         report.stops_over += r.stops_over;
         report.stops_not_at_rest += r.stops_not_at_rest;
         report.skipped += r.skipped;
+        report.replans += r.replans;
+        for (k, n) in &r.replans_refused {
+            *report.replans_refused.entry(k.clone()).or_default() += n;
+        }
+        report.replans_too_long += r.replans_too_long;
+        report.late_swaps += r.late_swaps;
+        report.late_swaps_taken += r.late_swaps_taken;
+        report.swaps_not_armed += r.swaps_not_armed;
+        report.swaps_cancelled += r.swaps_cancelled;
         report.clocks += r.clocks;
         report.ticks += r.ticks;
         report.planner_disagreements += r.planner_disagreements;
@@ -831,6 +1125,7 @@ mod tests {
             at_rest: rng.gen(),
             active_bank: rng.gen(),
             standby_count: rng.gen_range(0..64),
+            swap_pending: rng.gen(),
         }
     }
 

@@ -14,7 +14,7 @@ use crate::layout::{harness_header, pack, Port, Slot};
 use crate::SimError;
 
 /// The core's inputs, in the harness's word order (the wrapper registers each of them).
-pub const CORE_INPUTS: [Port; 15] = [
+pub const CORE_INPUTS: [Port; 17] = [
     Port {
         name: "reset",
         bits: 1,
@@ -75,10 +75,18 @@ pub const CORE_INPUTS: [Port; 15] = [
         name: "count_value",
         bits: INDEX_BITS as u32,
     },
+    Port {
+        name: "swap",
+        bits: 1,
+    },
+    Port {
+        name: "swap_last",
+        bits: 32,
+    },
 ];
 
 /// The core's outputs, in [`crate::cosim::Register`] order.
-pub const CORE_OUTPUTS: [Port; 19] = [
+pub const CORE_OUTPUTS: [Port; 20] = [
     Port {
         name: "x",
         bits: X_BITS as u32,
@@ -155,14 +163,18 @@ pub const CORE_OUTPUTS: [Port; 19] = [
         name: "ticks",
         bits: 64,
     },
+    Port {
+        name: "swap_pending",
+        bits: 1,
+    },
 ];
 
-const IN_LAYOUT: ([Slot; 15], usize) = pack(&CORE_INPUTS);
-const OUT_LAYOUT: ([Slot; 19], usize) = pack(&CORE_OUTPUTS);
+const IN_LAYOUT: ([Slot; 17], usize) = pack(&CORE_INPUTS);
+const OUT_LAYOUT: ([Slot; 20], usize) = pack(&CORE_OUTPUTS);
 /// Where each input is in the input words.
-pub const IN_SLOTS: [Slot; 15] = IN_LAYOUT.0;
+pub const IN_SLOTS: [Slot; 17] = IN_LAYOUT.0;
 /// Where each output is in a clock's output words.
-pub const OUT_SLOTS: [Slot; 19] = OUT_LAYOUT.0;
+pub const OUT_SLOTS: [Slot; 20] = OUT_LAYOUT.0;
 /// Input words per `set` call.
 pub const IN_WORDS: usize = IN_LAYOUT.1;
 /// Output words per clock.
@@ -281,7 +293,7 @@ impl Drop for Fabric {
 /// The inputs in the harness's word layout.
 pub fn encode_inputs(i: &CoreInputs) -> [u32; IN_WORDS] {
     let mut w = [0u32; IN_WORDS];
-    let values: [u128; 15] = [
+    let values: [u128; 17] = [
         u128::from(i.reset),
         u128::from(i.tick_div),
         u128::from(i.start),
@@ -297,6 +309,8 @@ pub fn encode_inputs(i: &CoreInputs) -> [u32; IN_WORDS] {
         i.write_snap as u128,
         u128::from(i.count_enable),
         u128::from(i.count_value),
+        u128::from(i.swap),
+        u128::from(i.swap_last),
     ];
     for (slot, v) in IN_SLOTS.iter().zip(values) {
         slot.put(&mut w, v);
@@ -340,6 +354,7 @@ pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
         R::StandbyCount,
         R::TickCount,
         R::Ticks,
+        R::SwapPending,
     );
     w
 }
@@ -369,5 +384,6 @@ pub fn decode(w: &[u32], f: &Format) -> CoreOutputs {
         standby_count: get(R::StandbyCount) as u8,
         tick_count: get(R::TickCount) as u32,
         ticks: get(R::Ticks) as u64,
+        swap_pending: flag(R::SwapPending),
     }
 }

@@ -155,6 +155,10 @@ pub struct IoCosimReport {
     pub undocumented: Vec<(u8, u8)>,
     /// Moves uploaded and started (START acknowledged).
     pub moves_started: u64,
+    /// Program swaps armed (SWAP_AT acknowledged).
+    pub swaps_armed: u64,
+    /// Clocks with a swap armed.
+    pub swap_pending_clocks: u64,
     /// STOP and HALT commands acknowledged.
     pub stops_acked: u64,
     /// Clocks with a controlled stop running.
@@ -192,6 +196,8 @@ impl IoCosimReport {
         self.frames_sent += o.frames_sent;
         self.damaged_sent += o.damaged_sent;
         self.moves_started += o.moves_started;
+        self.swaps_armed += o.swaps_armed;
+        self.swap_pending_clocks += o.swap_pending_clocks;
         self.stops_acked += o.stops_acked;
         self.stopping_clocks += o.stopping_clocks;
         self.overflow_clocks += o.overflow_clocks;
@@ -376,6 +382,17 @@ impl Stream {
         }
         let count = plan.program.segments.len() as u8;
         self.send(peer, Command::Commit { count });
+        if self.rng.gen_bool(0.4) {
+            // A program swap instead of a start (from rest, or mid-move: a replan), for a tick
+            // from well before to well after the upload's airtime: late ones are refused.
+            let per_tick = u64::from(self.design.dividers.tick_div) + 1;
+            let airtime =
+                (u64::from(count) + 2) * 30 * 10 * u64::from(self.design.dividers.uart_divisor);
+            let lead = (airtime as f64 * self.rng.gen_range(0.2..3.0)) as u64 / per_tick;
+            let tick = dev.core().outputs().ticks + lead;
+            self.send(peer, Command::SwapAt { tick });
+            return;
+        }
         self.send(peer, Command::Start);
         if self.rng.gen_bool(0.2) {
             // Again: the program was consumed (NO_PROGRAM), or it plays (BUSY).
@@ -398,7 +415,7 @@ impl Stream {
     /// Bytes of a damaged frame, or noise.
     fn damaged(&mut self, peer: &mut Peer) {
         let r = &mut self.rng;
-        let c = random_command(r, &self.design.format);
+        let c = random_command(r, &self.design.format, 0);
         let seq = self.seq.wrapping_add(1).max(1);
         self.seq = seq;
         let mut bytes = c.to_frame(seq, &self.design.format).to_bytes();
@@ -492,7 +509,7 @@ impl Stream {
                 self.send(peer, c);
             }
             38..=49 => {
-                let c = random_command(r, &self.design.format);
+                let c = random_command(r, &self.design.format, dev.core().outputs().ticks);
                 self.send(peer, c);
             }
             50..=54 => {
@@ -648,6 +665,9 @@ impl Stream {
         if st.has(flag::REPLY_OVERFLOW) {
             self.report.overflow_clocks += 1;
         }
+        if st.has(flag::SWAP_PENDING) {
+            self.report.swap_pending_clocks += 1;
+        }
         if st.state == AxisState::ErrorStop as u8 && self.last_state != st.state {
             IoCosimReport::bump(&mut self.report.errors, st.error);
             // The stalled motor is free again once the fault has stopped it.
@@ -677,11 +697,15 @@ impl Stream {
                         }
                     }
                     Some(Reply::Ack { cmd }) => {
+                        // (Counted by their replies: a swap's ACK is its only one.)
+                        if cmd == code::SWAP_AT {
+                            self.report.swaps_armed += 1;
+                        }
                         if let Some(k) = self.pending.iter().position(|&(s, _)| s == f.seq) {
                             self.pending.remove(k);
                             if cmd == code::START {
                                 self.report.moves_started += 1;
-                            } else {
+                            } else if cmd != code::SWAP_AT {
                                 self.report.stops_acked += 1;
                             }
                         }
@@ -711,10 +735,10 @@ fn stop_limits(r: &mut StdRng) -> (i128, i128) {
 }
 
 /// Any command with random arguments (good and bad).
-fn random_command(r: &mut StdRng, f: &Format) -> Command {
+fn random_command(r: &mut StdRng, f: &Format, ticks: u64) -> Command {
     let n = snapgen_model::protocol::PARAMS.len() as u8;
     let param = Param::from_byte(r.gen_range(1..=n)).expect("1..=n are parameters");
-    match r.gen_range(0..12) {
+    match r.gen_range(0..13) {
         0 => Command::Ping,
         1 => Command::LoadSegment {
             index: r.gen_range(0..f.max_segments as u8),
@@ -736,6 +760,14 @@ fn random_command(r: &mut StdRng, f: &Format) -> Command {
             on: r.gen_bool(0.5),
         },
         10 => Command::Reset,
+        // Anywhere (mostly too far: BAD_ARGUMENT), or near the time base (late or armed).
+        11 => Command::SwapAt {
+            tick: if r.gen_bool(0.3) {
+                r.gen()
+            } else {
+                ticks.wrapping_add_signed(r.gen_range(-2000..20_000))
+            },
+        },
         // (INPUT_POLARITY is written by `Stream::configure`, which keeps the emergency stop's
         // bit as wired.)
         _ => Command::Configure {
@@ -912,7 +944,7 @@ pub fn describe(r: &IoCosimReport) -> String {
         .collect();
     let count = |c: u8| IoCosimReport::count(&r.replies, c);
     format!(
-        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
+        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} swaps armed ({} clocks armed), {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
         r.clocks,
         r.frames_sent,
         r.damaged_sent,
@@ -925,6 +957,8 @@ pub fn describe(r: &IoCosimReport) -> String {
         count(code::CONFIG),
         count(code::TELEMETRY),
         r.moves_started,
+        r.swaps_armed,
+        r.swap_pending_clocks,
         r.stops_acked,
         r.stopping_clocks,
         if errors.is_empty() { "none".into() } else { errors.join(", ") },

@@ -3,6 +3,9 @@
 //! are empty in others; a few moves run with a tick divider, a few are aborted midway and many
 //! get a controlled stop at a random clock (with random stop limits, some of them too low for
 //! the state the stop begins from), some with a second request or an abort during the stop.
+//! A share of the moves that play to their end is replanned on the way: a chain of program
+//! swaps at random ticks (docs/PROTOCOL.md, SWAP_AT), drawn in the co-simulation from
+//! `replan_seed` (see `crate::cosim`).
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -55,6 +58,10 @@ pub struct MoveSpec {
     pub stop_again_after: Option<u64>,
     /// Abort this many clocks after the stop request (cancels the stop).
     pub abort_stop_after: Option<u64>,
+    /// Online replans of this move (program swaps at random ticks; 0: none).
+    pub replans: u8,
+    /// Seed of the replans' random choices (when, where to, with which limits).
+    pub replan_seed: u64,
 }
 
 impl MoveSpec {
@@ -69,6 +76,8 @@ impl MoveSpec {
             stop_limits: StopLimits::default(),
             stop_again_after: None,
             abort_stop_after: None,
+            replans: 0,
+            replan_seed: 0,
         }
     }
 }
@@ -78,23 +87,29 @@ pub struct MoveStream {
     rng: StdRng,
     mix: OrderMix,
     stop_share: f64,
+    replan_share: f64,
 }
 
 /// The share of moves given a controlled stop by default.
 pub const DEFAULT_STOP_SHARE: f64 = 0.25;
+/// The share of the remaining moves replanned on the way by default.
+pub const DEFAULT_REPLAN_SHARE: f64 = 0.2;
 
-fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
+/// A number drawn log-uniformly from `lo..=hi`.
+pub fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
     rng.gen_range(lo.ln()..=hi.ln()).exp()
 }
 
 impl MoveStream {
     /// The stream for `seed`, with a controlled stop in a share `stop_share` of the moves
-    /// (each stopping tick takes the stop unit's decision, about 130 clocks).
-    pub fn new(seed: u64, mix: OrderMix, stop_share: f64) -> Self {
+    /// (each stopping tick takes the stop unit's decision, about 130 clocks) and 1 to 8
+    /// online replans in a share `replan_share` of the others.
+    pub fn new(seed: u64, mix: OrderMix, stop_share: f64, replan_share: f64) -> Self {
         MoveStream {
             rng: StdRng::seed_from_u64(seed),
             mix,
             stop_share: stop_share.clamp(0.0, 1.0),
+            replan_share: replan_share.clamp(0.0, 1.0),
         }
     }
 
@@ -191,6 +206,12 @@ impl MoveStream {
         let abort_stop_after = stop_after
             .filter(|_| r.gen_bool(0.1))
             .map(|_| r.gen_range(1..3000));
+        let replans =
+            if abort_after.is_none() && stop_after.is_none() && r.gen_bool(self.replan_share) {
+                r.gen_range(1..=8)
+            } else {
+                0
+            };
         MoveSpec {
             request: MoveRequest { distance, method },
             ts,
@@ -200,6 +221,8 @@ impl MoveStream {
             stop_limits: StopLimits { jerk, accel },
             stop_again_after,
             abort_stop_after,
+            replans,
+            replan_seed: r.gen(),
         }
     }
 }

@@ -10,7 +10,7 @@ use snapgen_sim::io_cosim::{cosim_design, describe, run, IoCosimConfig, IoCosimR
 /// exercised on the way.
 #[test]
 fn random_command_streams_match_bit_for_bit() {
-    let r = run(&cosim_design(), &IoCosimConfig::new(4_000_000, 11, 2)).unwrap();
+    let r = run(&cosim_design(), &IoCosimConfig::new(4_000_000, 14, 2)).unwrap();
     eprintln!("{}", describe(&r));
     assert_eq!(r.mismatch, None);
     assert!(r.clocks >= 8_000_000, "only {} clocks", r.clocks);
@@ -40,6 +40,8 @@ fn random_command_streams_match_bit_for_bit() {
         Reason::NotConfigured,
         Reason::Limit,
         Reason::NotDisabled,
+        Reason::Late,
+        Reason::SwapPending,
     ] {
         assert!(
             IoCosimReport::count(&r.naks, reason as u8) > 0,
@@ -68,6 +70,7 @@ fn random_command_streams_match_bit_for_bit() {
         );
     }
     assert!(r.moves_started >= 10, "{} moves", r.moves_started);
+    assert!(r.swaps_armed >= 10, "{} swaps armed", r.swaps_armed);
     assert!(r.stops_acked >= 10, "{} stops", r.stops_acked);
     assert!(r.stopping_clocks > 10_000);
     assert!(r.overflow_clocks > 0, "the reply queue never overflowed");

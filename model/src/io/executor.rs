@@ -229,6 +229,10 @@ pub struct ExecutorInputs {
     pub following_fault: bool,
     /// The controller skipped a sample.
     pub servo_overrun: bool,
+    /// Core: the time base (ticks since reset).
+    pub ticks: u64,
+    /// Core: a program swap is armed.
+    pub swap_pending: bool,
 }
 
 /// Outputs after a clock edge.
@@ -248,6 +252,10 @@ pub struct ExecutorOutputs {
     pub count_value: u8,
     /// Core: start.
     pub start: bool,
+    /// Core: arm a program swap for the tick after `swap_last`.
+    pub swap: bool,
+    /// Core: the low 32 bits of the swap's tick minus one (held until the next SWAP_AT).
+    pub swap_last: u32,
     /// Core: controlled stop.
     pub stop: bool,
     /// Core: abort (emergency stop, following error).
@@ -299,6 +307,10 @@ pub struct Executor {
     was_driven: bool,
     /// The sign of the standby program's first snap (segment 0): +1, −1 or 0.
     first_direction: i8,
+    /// A SWAP_AT's tick less the time base, registered every clock from the received
+    /// payload (taken as an 8-byte one): one clock old when the frame is executed, so no
+    /// 64-bit subtraction lies in the command's decision path.
+    swap_lead: u64,
 }
 
 impl Executor {
@@ -325,6 +337,7 @@ impl Executor {
         self.out.write_enable = false;
         self.out.count_enable = false;
         self.out.start = false;
+        self.out.swap = false;
         self.out.stop = false;
         self.out.abort = false;
         self.out.load = false;
@@ -341,6 +354,7 @@ impl Executor {
             self.telemetry_left = 0;
             self.was_driven = false;
             self.first_direction = 0;
+            self.swap_lead = 0;
             return self.out;
         }
         let s = before.state;
@@ -401,7 +415,8 @@ impl Executor {
         // The axis by itself: the end of a move or a stop (at rest: Standstill; a program that
         // ended moving: a controlled stop into ErrorStop), then the errors (the emergency stop
         // last: it overrides everything).
-        let settling = before.start || before.stop;
+        // (A swap armed while the axis rests is a start still to come.)
+        let settling = before.start || before.stop || before.swap;
         if matches!(
             o.state,
             AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::Stopping
@@ -409,6 +424,7 @@ impl Executor {
             && !i.busy
             && !i.stopping
             && !settling
+            && (!i.at_rest || !i.swap_pending)
         {
             if i.at_rest {
                 o.state = AxisState::Standstill;
@@ -441,6 +457,7 @@ impl Executor {
             o.abort = true;
             o.stop = false;
             o.start = false;
+            o.swap = false;
             o.amplifier = false;
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::FollowingError;
@@ -451,11 +468,13 @@ impl Executor {
             o.abort = true;
             o.stop = false;
             o.start = false;
+            o.swap = false;
             o.amplifier = false;
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::EmergencyStop;
         }
 
+        self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.ticks);
         self.out
     }
 
@@ -531,24 +550,38 @@ impl Executor {
         let rx = &i.rx;
         let arg0 = rx.byte(0);
         let moving = i.busy || i.stopping || !i.at_rest;
+        let toward_limit = (self.first_direction > 0 && i.limit_positive)
+            || (self.first_direction < 0 && i.limit_negative);
         let refuse = match rx.cmd {
             code::LOAD_SEGMENT if usize::from(arg0) >= BANK_DEPTH || rx.field(1, 4) == 0 => {
                 Some(Reason::BadArgument)
             }
             code::COMMIT if usize::from(arg0) > BANK_DEPTH => Some(Reason::BadArgument),
+            code::LOAD_SEGMENT | code::COMMIT if i.swap_pending => Some(Reason::SwapPending),
+            code::SWAP_AT if self.swap_lead as i64 >= SWAP_REACH => Some(Reason::BadArgument),
             code::START => match s {
                 AxisState::Disabled => Some(Reason::NotEnabled),
                 AxisState::ErrorStop => Some(Reason::AxisError),
                 AxisState::Stopping => Some(Reason::Stopping),
                 _ if i.busy => Some(Reason::Busy),
                 _ if i.stopping => Some(Reason::Stopping),
+                _ if i.swap_pending => Some(Reason::SwapPending),
                 _ if i.standby_count == 0 => Some(Reason::NoProgram),
                 _ if !i.at_rest => Some(Reason::Busy),
-                _ if (self.first_direction > 0 && i.limit_positive)
-                    || (self.first_direction < 0 && i.limit_negative) =>
-                {
-                    Some(Reason::Limit)
-                }
+                _ if toward_limit => Some(Reason::Limit),
+                _ => None,
+            },
+            code::SWAP_AT => match s {
+                AxisState::Disabled => Some(Reason::NotEnabled),
+                AxisState::ErrorStop => Some(Reason::AxisError),
+                AxisState::Stopping => Some(Reason::Stopping),
+                _ if i.stopping => Some(Reason::Stopping),
+                _ if i.swap_pending => Some(Reason::SwapPending),
+                _ if i.standby_count == 0 => Some(Reason::NoProgram),
+                // The lead is one clock old and the core arms one clock later: the time base
+                // may have ticked twice by then, and the core wants three ticks of lead.
+                _ if (self.swap_lead as i64) < SWAP_MIN_LEAD => Some(Reason::Late),
+                _ if i.at_rest && !i.busy && toward_limit => Some(Reason::Limit),
                 _ => None,
             },
             code::STOP if s == AxisState::Disabled => Some(Reason::NotEnabled),
@@ -618,6 +651,13 @@ impl Executor {
                 // The banks swap: the new standby program is empty.
                 self.first_direction = 0;
             }
+            code::SWAP_AT => {
+                o.swap = true;
+                o.swap_last = (rx.field(0, 8) as u64).wrapping_sub(1) as u32;
+                o.state = AxisState::DiscreteMotion;
+                // The banks swap at the tick; no upload is taken before that.
+                self.first_direction = 0;
+            }
             code::STOP if s != AxisState::ErrorStop => {
                 o.stop = true;
                 o.state = AxisState::Stopping;
@@ -665,6 +705,21 @@ impl Executor {
             _ => {}
         }
     }
+}
+
+/// How far ahead of the time base a SWAP_AT may lie: the core compares the low 32 bits.
+pub const SWAP_REACH: i64 = 1 << 31;
+
+/// The least lead a SWAP_AT is accepted with, over the time base on the clock before the one
+/// that executes it (docs/PROTOCOL.md, "Program swaps").
+pub const SWAP_MIN_LEAD: i64 = 5;
+
+/// SWAP_AT's `tick`, read from the received payload as if it were an 8-byte one (the last 8
+/// bytes received), as the fabric wires it.
+fn swap_tick_field(rx: &crate::io::frame_rx::FrameRxOutputs) -> u64 {
+    (0..8).fold(0u64, |acc, k| {
+        acc | (u64::from(rx.payload[7 - k]) << (8 * k))
+    })
 }
 
 /// False when setting `p` to `value` would leave the stop limits unusable

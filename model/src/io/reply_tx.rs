@@ -214,6 +214,7 @@ pub fn status(s: &StatusInputs) -> Status {
         (e.uart_error, flag::UART_ERROR),
         (e.reply_overflow, flag::REPLY_OVERFLOW),
         (e.servo_overrun, flag::SERVO_OVERRUN),
+        (c.swap_pending, flag::SWAP_PENDING),
     ] {
         if on {
             flags |= bit;
