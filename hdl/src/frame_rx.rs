@@ -142,12 +142,15 @@ impl Logic for FrameRx {
         self.step.crc_in.next = self.crc_acc.q.val();
         self.step.data.next = self.data.val();
         self.payload_bytes.data.next = self.data.val();
-        // Payload and CRC bytes are kept (the CRC for the executor's retry rule).
-        self.payload_bytes.shift.next = self.valid.val()
-            & ((self.state.q.val() == self.s_pay.val())
-                | (self.state.q.val() == self.s_crcl.val())
-                | (self.state.q.val() == self.s_crch.val()))
-            & !self.reset.val();
+        // Payload bytes are kept as they arrive, the CRC when its high byte does (for the
+        // executor's retry rule).
+        self.payload_bytes.shift.next =
+            self.valid.val() & (self.state.q.val() == self.s_pay.val()) & !self.reset.val();
+        self.payload_bytes.take_crc.next = self.valid.val()
+            & (self.state.q.val() == self.s_crch.val())
+            & !self.reset.val()
+            & !self.line_error.val();
+        self.payload_bytes.crc_low.next = self.crc_lo.q.val();
         self.frame_reg.d.next = false;
         self.bad_reg.d.next = false;
         self.dropped_reg.d.next = false;
