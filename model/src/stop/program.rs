@@ -520,12 +520,37 @@ mod tests {
         }
     }
 
+    /// Limits a CONFIGURE can set: at most `Param::StopAccel.max()` (103 bits, the engine's
+    /// limit inputs), as the executor refuses larger ones.
     fn limits() -> impl Strategy<Value = StopLimits> {
-        (0u32..100, 0u32..100, 1i128..1000, 1i128..1000).prop_map(|(jb, ab, jm, am)| {
+        let most = crate::protocol::Param::StopAccel.max();
+        (0u32..100, 0u32..100, 1i128..1000, 1i128..1000).prop_map(move |(jb, ab, jm, am)| {
             let jerk = (jm << jb.min(90)).max(1);
-            let accel = (am << ab.min(100)).max(jerk);
+            let accel = (am << ab.min(100)).min(most).max(jerk);
             StopLimits { jerk, accel }
         })
+    }
+
+    /// A long jerk-limited stop from a high speed with the widest acceleration limit a
+    /// CONFIGURE can set. (proptest once drew this state with an acceleration limit of 2^108,
+    /// which the executor refuses and the engine's 103-bit inputs cannot hold: the test's
+    /// strategy was at fault, not the engine.)
+    #[test]
+    fn the_engine_stops_as_the_law_at_the_widest_limits() {
+        let l = StopLimits {
+            jerk: 216_576,
+            accel: crate::protocol::Param::StopAccel.max(),
+        };
+        let s = ChainState {
+            x: 0,
+            v: -758_495_629_464_170_268,
+            a: 0,
+            j: 0,
+        };
+        let (want, law) = play(s, l, 3000);
+        let (got, over) = engine_stop(s, l, 3000);
+        assert_eq!(over, law.over_limits());
+        assert_eq!(got, want);
     }
 
     proptest! {
