@@ -12,6 +12,7 @@
 //!
 //! This crate does no I/O.
 
+pub mod axis;
 pub mod chain;
 pub mod core;
 pub mod device;

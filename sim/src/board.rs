@@ -12,7 +12,9 @@ use snapgen_plant::plant::StepError;
 use snapgen_plant::{BridgePins, Physical, Plant};
 
 use crate::build::build_io;
-use crate::io::{decode_outputs, encode_inputs, FabricIo, IN_WORDS, OUT_WORDS};
+use crate::io::{
+    decode_outputs, encode_inputs, encode_outputs, FabricIo, IoSignal, IN_WORDS, OUT_WORDS,
+};
 use crate::SimError;
 
 /// Clocks the fabric runs per call: the peer computes their pins ahead (the encoder follows
@@ -25,6 +27,22 @@ enum Backend {
     Model(Box<Device>),
     /// The Verilated I/O top.
     Fabric(FabricIo),
+    /// The Verilated I/O top driving the pins, the device model beside it on the same inputs,
+    /// every output compared on every clock.
+    Lockstep(FabricIo, Box<Device>),
+}
+
+/// The first clock the fabric's outputs differed from the model's (lockstep boards).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoardMismatch {
+    /// Clock.
+    pub clock: u64,
+    /// The first differing signal.
+    pub signal: IoSignal,
+    /// The model's value.
+    pub expected: u128,
+    /// The fabric's.
+    pub actual: u128,
 }
 
 /// A virtual board.
@@ -36,6 +54,9 @@ pub struct VirtualBoard {
     ins: Vec<[u32; IN_WORDS]>,
     outs: Vec<u32>,
     motor: Option<Plant>,
+    mismatches: u64,
+    first_mismatch: Option<BoardMismatch>,
+    fault: Option<(u64, IoSignal, u32)>,
 }
 
 impl VirtualBoard {
@@ -54,6 +75,36 @@ impl VirtualBoard {
         ))
     }
 
+    /// The Verilated I/O top of `design` with the device model in lockstep: every output of
+    /// every clock compared ([`VirtualBoard::mismatches`]); the fabric drives the pins.
+    pub fn lockstep(design: &Design) -> Result<Self, SimError> {
+        let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+        let built = build_io(&verilog, false)?;
+        Ok(Self::with(
+            design,
+            Backend::Lockstep(
+                FabricIo::open(&built.library, None)?,
+                Box::new(Device::new(design)),
+            ),
+        ))
+    }
+
+    /// Clocks whose outputs differed, fabric against model (lockstep boards; 0 otherwise).
+    pub fn mismatches(&self) -> u64 {
+        self.mismatches
+    }
+
+    /// The first of them.
+    pub fn first_mismatch(&self) -> Option<BoardMismatch> {
+        self.first_mismatch
+    }
+
+    /// Test hook (lockstep boards): flip `bit` of `signal` in the fabric's outputs at `clock`,
+    /// to show that a one-bit difference is counted.
+    pub fn inject_fault(&mut self, clock: u64, signal: IoSignal, bit: u32) {
+        self.fault = Some((clock, signal, bit));
+    }
+
     fn with(design: &Design, backend: Backend) -> Self {
         let mut peer = Peer::new(design.dividers.uart_divisor);
         // The switches wired as the design expects them.
@@ -66,6 +117,9 @@ impl VirtualBoard {
             ins: Vec::new(),
             outs: Vec::new(),
             motor: None,
+            mismatches: 0,
+            first_mismatch: None,
+            fault: None,
         }
     }
 
@@ -138,18 +192,52 @@ impl VirtualBoard {
                     }
                 }
             }
-            Backend::Fabric(fab) => {
+            Backend::Fabric(_) | Backend::Lockstep(..) => {
+                let (fab, mut model) = match &mut self.backend {
+                    Backend::Fabric(f) => (f, None),
+                    Backend::Lockstep(f, d) => (f, Some(d)),
+                    Backend::Model(_) => unreachable!("matched above"),
+                };
                 let mut left = clocks;
+                let mut clock = self.clocks;
+                let mut model_ins = Vec::new();
                 while left > 0 {
                     let n = left.min(chunk) as usize;
                     self.ins.clear();
+                    model_ins.clear();
                     for _ in 0..n {
-                        self.ins.push(encode_inputs(&self.peer.inputs()));
+                        let i = self.peer.inputs();
+                        self.ins.push(encode_inputs(&i));
+                        model_ins.push(i);
                     }
                     fab.run(&self.ins, &mut self.outs);
-                    for k in 0..n {
-                        let o = decode_outputs(&self.outs[k * OUT_WORDS..(k + 1) * OUT_WORDS]);
+                    for (k, i) in model_ins.iter().enumerate() {
+                        let words = &mut self.outs[k * OUT_WORDS..(k + 1) * OUT_WORDS];
+                        if let Some(dev) = model.as_mut() {
+                            if let Some((at, signal, bit)) = self.fault {
+                                if at == clock {
+                                    signal.flip(words, bit);
+                                }
+                            }
+                            let want = encode_outputs(&dev.clock(i));
+                            if words != want.as_slice() {
+                                self.mismatches += 1;
+                                if self.first_mismatch.is_none() {
+                                    let signal = IoSignal::all()
+                                        .find(|s| s.value(words) != s.value(&want))
+                                        .expect("every output bit belongs to a signal (tested)");
+                                    self.first_mismatch = Some(BoardMismatch {
+                                        clock,
+                                        signal,
+                                        expected: signal.value(&want),
+                                        actual: signal.value(words),
+                                    });
+                                }
+                            }
+                        }
+                        let o = decode_outputs(words);
                         Self::observe(&mut self.peer, &mut self.motor, &o);
+                        clock += 1;
                     }
                     if let Some(m) = &self.motor {
                         self.peer.drive_encoder(m.count());

@@ -17,6 +17,7 @@ pub mod build;
 pub mod closed_loop;
 pub mod cosim;
 pub mod fabric;
+pub mod host_link;
 pub mod io;
 pub mod io_cosim;
 pub mod layout;

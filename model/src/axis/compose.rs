@@ -1,0 +1,549 @@
+//! Composing a change: which parts of the timeline keep playing, which are replanned, from
+//! which exact state, and the program the fabric plays from the swap tick.
+
+use crate::chain::ChainState;
+use crate::format::{Format, Quantity};
+use crate::online::{plan_online, OnlineError, OnlineLimits, OnlineTarget};
+use crate::program::{Program, Segment};
+
+use super::{
+    scaled, AxisErrorId, BufferMode, Change, Goal, HostAxis, MotionCommand, Outcome, Part, Timeline,
+};
+
+/// What changed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Request {
+    /// Command `k` was submitted.
+    Command(usize),
+    /// The override becomes this factor (0–2).
+    Override(f64),
+}
+
+/// Why a change could not be planned: the command to put in Error and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Refusal {
+    /// The command that fails (the new one, or for an override the one it replans).
+    pub command: Option<usize>,
+    /// Why.
+    pub error: AxisErrorId,
+}
+
+/// Largest override (PLCopen: 0–200 %).
+pub const MAX_OVERRIDE: f64 = 2.0;
+
+impl HostAxis {
+    /// Records `cmd` (Busy) and returns its index; its inputs are checked here (a bad input
+    /// is an Error at once and needs no change).
+    pub fn submit(&mut self, cmd: MotionCommand) -> usize {
+        let outcome = match check_inputs(&cmd, &self.settings.format) {
+            Ok(()) => Outcome::Busy,
+            Err(e) => Outcome::Error(e),
+        };
+        self.commands.push(super::CommandRecord {
+            command: cmd,
+            outcome,
+            note: None,
+        });
+        self.commands.len() - 1
+    }
+
+    /// Commands still to be done at tick `at`: busy, with a part that ends after `at`, a
+    /// paused or velocity-holding part, or no part yet.
+    fn live(&self, at: u64) -> Vec<usize> {
+        let mut out: Vec<usize> = Vec::new();
+        for (k, rec) in self.commands.iter().enumerate() {
+            if !rec.outcome.busy() {
+                continue;
+            }
+            let part = self.timeline.parts.iter().rev().find(|p| p.command == k);
+            let live = match part {
+                None => true,
+                Some(p) => {
+                    p.end_tick() > at || p.paused || matches!(p.goal, Goal::Velocity(v) if v != 0.0)
+                }
+            };
+            if live {
+                out.push(k);
+            }
+        }
+        out
+    }
+
+    /// The change that realises `req` with the swap at tick `at` (the host chooses `at`
+    /// ahead of the link's latency). A blend the planner cannot realise from the state the
+    /// previous move is in at `at` falls back to Buffered (the previous move unchanged; the
+    /// command's note says so).
+    pub fn plan_change(&self, at: u64, req: Request) -> Result<Change, Refusal> {
+        match self.plan_change_with(at, req, true) {
+            Err(_) if self.blends(req) => {
+                let mut c = self.plan_change_with(at, req, false)?;
+                if let Request::Command(k) = req {
+                    c.notes.push((
+                        k,
+                        "the previous move could not be replanned to blend from where it was: buffered instead"
+                            .into(),
+                    ));
+                }
+                Ok(c)
+            }
+            r => r,
+        }
+    }
+
+    /// True when `req` is a blending move.
+    fn blends(&self, req: Request) -> bool {
+        matches!(req, Request::Command(k) if !matches!(
+            self.commands[k].command.buffer_mode(),
+            BufferMode::Aborting | BufferMode::Buffered
+        ))
+    }
+
+    fn plan_change_with(&self, at: u64, req: Request, blend: bool) -> Result<Change, Refusal> {
+        let f = &self.settings.format;
+        let mut k = self.override_factor;
+        let mut live = self.live(at);
+        let mut aborts = Vec::new();
+        let mut notes = Vec::new();
+        // Parts to keep whole (their index in the timeline), then specs to plan.
+        let playing_from = self
+            .timeline
+            .parts
+            .iter()
+            .position(|p| p.end_tick() > at)
+            .unwrap_or(self.timeline.parts.len());
+        let mut keep = self.timeline.parts.len();
+        match req {
+            Request::Override(f) => {
+                if !(0.0..=MAX_OVERRIDE).contains(&f) {
+                    return Err(Refusal {
+                        command: None,
+                        error: AxisErrorId::InvalidInput(format!(
+                            "override {f} is outside 0–{MAX_OVERRIDE}: give a factor from 0 to 2 (0–200 %)"
+                        )),
+                    });
+                }
+                k = f;
+                keep = playing_from;
+            }
+            Request::Command(new) => {
+                let cmd = self.commands[new].command;
+                // Commands given after this one (due in the same batch) are planned with their
+                // own requests.
+                live.retain(|&c| c < new);
+                let mode = cmd.buffer_mode();
+                let last_paused = self.timeline.parts.last().is_some_and(|p| p.paused);
+                let holding = self
+                    .timeline
+                    .parts
+                    .last()
+                    .is_some_and(|p| matches!(p.goal, Goal::Velocity(v) if v != 0.0));
+                // A held velocity never ends: a move after it takes over as an aborting one.
+                if mode == BufferMode::Aborting || holding {
+                    aborts = live.clone();
+                    live.clear();
+                    keep = playing_from;
+                } else if last_paused || live.is_empty() {
+                    // Nothing to follow, or the axis waits at override 0: the new move queues.
+                    keep = playing_from;
+                } else if blend
+                    && mode != BufferMode::Buffered
+                    && self.blend_at_last(new) != 0.0
+                    && self
+                        .timeline
+                        .parts
+                        .last()
+                        .is_some_and(|p| matches!(p.goal, Goal::Position { .. }))
+                {
+                    // Blends: the last part is replanned to its blend point.
+                    let last = self.timeline.parts.len() - 1;
+                    if self.timeline.parts[last].end_tick() > at {
+                        keep = last;
+                    } else {
+                        notes.push((new, "blend too late: the previous move had ended".into()));
+                    }
+                }
+                live.push(new);
+            }
+        }
+        // The kept parts; the part playing at `at` among the replanned ones is cut there.
+        let parts = &self.timeline.parts;
+        let mut out: Vec<Part> = parts[..keep].to_vec();
+        let (mut tick, mut state) = match out.last() {
+            Some(p) => (
+                p.end_tick().max(at),
+                self.timeline.state_at(p.end_tick().max(at), f),
+            ),
+            None => (at, self.timeline.state_at(at, f)),
+        };
+        if let Some(p) = parts.get(keep) {
+            if p.start_tick >= at {
+                tick = p.start_tick;
+                state = p.start;
+            } else {
+                let cut = at - p.start_tick;
+                out.push(Part {
+                    program: prefix(&p.program, cut),
+                    end: self.timeline.state_at(at, f),
+                    paused: false,
+                    cut: true,
+                    ..p.clone()
+                });
+                tick = at;
+                state = self.timeline.state_at(at, f);
+            }
+        }
+        // Specs to plan: live commands without a kept part still to play (a paused or
+        // velocity-holding part that has ended is replanned).
+        let kept: Vec<usize> = out
+            .iter()
+            .filter(|p| !p.cut && p.end_tick() > at)
+            .map(|p| p.command)
+            .collect();
+        let specs: Vec<usize> = live.into_iter().filter(|c| !kept.contains(c)).collect();
+        let mut next_state = state;
+        for (i, &c) in specs.iter().enumerate() {
+            let next = specs.get(i + 1).map(|&n| self.commands[n].command);
+            let planned = plan_part(
+                &self.commands[c].command,
+                next.as_ref(),
+                &next_state,
+                k,
+                self,
+            )
+            .map_err(|e| Refusal {
+                command: Some(c),
+                error: e.into(),
+            })?;
+            let (program, end, goal, paused, note) = planned;
+            if let Some(n) = note {
+                notes.push((c, n));
+            }
+            let part = Part {
+                command: c,
+                start_tick: tick,
+                start: next_state,
+                end,
+                program,
+                goal,
+                paused,
+                cut: false,
+            };
+            tick = part.end_tick();
+            next_state = end;
+            out.push(part);
+            if paused || matches!(goal, Goal::Velocity(_)) {
+                // Nothing follows a pause or a held velocity.
+                break;
+            }
+        }
+        let timeline = Timeline {
+            origin: self.timeline.origin,
+            parts: out,
+        };
+        let program = timeline.program_from(at, f);
+        // A part must fit the program memory whole (the parts after it go up in later swaps).
+        if let Some(p) = timeline
+            .parts
+            .iter()
+            .find(|p| p.end_tick() > at && p.program.segments.len() > f.max_segments)
+        {
+            return Err(Refusal {
+                command: Some(p.command),
+                error: AxisErrorId::Planner(
+                    OnlineError::TooManySegments {
+                        count: p.program.segments.len(),
+                        max: f.max_segments,
+                    }
+                    .to_string(),
+                ),
+            });
+        }
+        Ok(Change {
+            at,
+            program,
+            timeline,
+            aborts,
+            notes,
+            override_factor: k,
+        })
+    }
+
+    /// Makes `c` the axis's state (after the board acknowledged its SWAP_AT).
+    pub fn apply(&mut self, c: Change) {
+        for &a in &c.aborts {
+            self.commands[a].outcome = Outcome::CommandAborted;
+        }
+        for (k, n) in c.notes {
+            self.commands[k].note = Some(n);
+        }
+        self.override_factor = c.override_factor;
+        self.timeline = c.timeline;
+    }
+}
+
+impl HostAxis {
+    /// The velocity the timeline's last part would pass its target at with command `next`
+    /// blending into it (0: no blend, a reversal, or not a position move).
+    fn blend_at_last(&self, next: usize) -> f64 {
+        let Some(last) = self.timeline.parts.last() else {
+            return 0.0;
+        };
+        let (Goal::Position { cell, .. }, MotionCommand::MoveAbsolute { velocity, .. }) =
+            (last.goal, self.commands[last.command].command)
+        else {
+            return 0.0;
+        };
+        let f = &self.settings.format;
+        let dist = cell - f.output_lsb(last.start.x);
+        blend_velocity(dist, cell, velocity, &self.commands[next].command, f)
+    }
+}
+
+/// The first `n` ticks of `p`.
+fn prefix(p: &Program, n: u64) -> Program {
+    let mut left = n;
+    let mut segments = Vec::new();
+    for s in &p.segments {
+        if left == 0 {
+            break;
+        }
+        let t = left.min(u64::from(s.ticks));
+        segments.push(Segment {
+            ticks: t as u32,
+            snap: s.snap,
+        });
+        left -= t;
+    }
+    Program { segments }
+}
+
+/// Inputs every command needs: finite, positive limits; a position the register holds.
+fn check_inputs(c: &MotionCommand, f: &Format) -> Result<(), AxisErrorId> {
+    let positive = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(AxisErrorId::InvalidInput(format!(
+                "{} {name} = {v}: give a finite value > 0",
+                c.name()
+            )))
+        }
+    };
+    match *c {
+        MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..
+        } => {
+            positive("velocity", velocity)?;
+            positive("acceleration", acceleration)?;
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+            let most = f.physical_max(Quantity::Position) * 0.5;
+            if !position.is_finite() || position.abs() > most {
+                return Err(AxisErrorId::InvalidInput(format!(
+                    "MC_MoveAbsolute position = {position}: give a position within ±{most:.6} (half the position register)"
+                )));
+            }
+        }
+        MotionCommand::MoveVelocity {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+        } => {
+            if !velocity.is_finite() {
+                return Err(AxisErrorId::InvalidInput(format!(
+                    "MC_MoveVelocity velocity = {velocity}: give a finite value"
+                )));
+            }
+            positive("acceleration", acceleration)?;
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+        }
+        MotionCommand::Halt { deceleration, jerk } => {
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+        }
+    }
+    Ok(())
+}
+
+type Planned = (Program, ChainState, Goal, bool, Option<String>);
+
+/// Plans one command's part from `from` with override `k`: a position move to its target at
+/// rest or at the blend velocity with `next`, a velocity, a halt.
+fn plan_part(
+    cmd: &MotionCommand,
+    next: Option<&MotionCommand>,
+    from: &ChainState,
+    k: f64,
+    axis: &HostAxis,
+) -> Result<Planned, OnlineError> {
+    let f = &axis.settings.format;
+    let order = axis.settings.order;
+    let run = |target: OnlineTarget, limits: OnlineLimits| {
+        plan_online(from, &target, &limits, order, f).map(|p| (p.program, p.final_state))
+    };
+    // A stop on the path (override 0, MC_Halt) with the command's deceleration.
+    let stop = |l: OnlineLimits| run(OnlineTarget::Velocity(0.0), l);
+    match *cmd {
+        MotionCommand::Halt { deceleration, jerk } => {
+            let l = OnlineLimits {
+                velocity: f.physical_max(Quantity::Velocity),
+                acceleration: deceleration,
+                deceleration,
+                jerk,
+            };
+            let (p, e) = stop(l)?;
+            Ok((p, e, Goal::Velocity(0.0), false, None))
+        }
+        MotionCommand::MoveVelocity {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+        } => {
+            let l = OnlineLimits {
+                velocity: if k > 0.0 {
+                    velocity.abs() * k
+                } else {
+                    velocity.abs()
+                },
+                acceleration,
+                deceleration,
+                jerk,
+            };
+            let v = velocity * k;
+            let (p, e) = if velocity == 0.0 {
+                stop(OnlineLimits {
+                    velocity: f.physical_max(Quantity::Velocity),
+                    ..l
+                })?
+            } else {
+                run(OnlineTarget::Velocity(v), l)?
+            };
+            Ok((p, e, Goal::Velocity(v), k == 0.0, None))
+        }
+        MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..
+        } => {
+            let l = OnlineLimits {
+                velocity,
+                acceleration,
+                deceleration,
+                jerk,
+            };
+            if k == 0.0 {
+                let (p, e) = stop(l)?;
+                return Ok((p, e, Goal::Velocity(0.0), true, None));
+            }
+            let cell = cell_of(position, f);
+            let here = f.output_lsb(from.x);
+            let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
+            let l = scaled(l, k);
+            let vb = vb * k;
+            let l = OnlineLimits {
+                velocity: l.velocity.max(vb.abs()),
+                ..l
+            };
+            let at = |v: f64| OnlineTarget::Position { cell, velocity: v };
+            match run(at(vb), l) {
+                Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
+                Err(OnlineError::BlendUnreachable) | Err(OnlineError::NotRealisable(_))
+                    if vb != 0.0 =>
+                {
+                    let (p, e) = run(at(0.0), l)?;
+                    Ok((
+                        p,
+                        e,
+                        Goal::Position {
+                            cell,
+                            velocity: 0.0,
+                        },
+                        false,
+                        Some("blend not reachable before the blend point: buffered instead".into()),
+                    ))
+                }
+                Err(e) => Err(e),
+            }
+        }
+    }
+}
+
+/// The output cell of a position (unit).
+pub fn cell_of(position: f64, f: &Format) -> i128 {
+    crate::planner::fmath::round(position / f.position_lsb) as i128
+}
+
+/// The velocity a move (`dist` cells toward its target `cell`, velocity `v`) passes its
+/// target at when `next` blends into it: per `next`'s BufferMode, signed as the motion, 0
+/// when the next move reverses, stands still or is not a blending move.
+fn blend_velocity(dist: i128, cell: i128, v: f64, next: &MotionCommand, f: &Format) -> f64 {
+    let MotionCommand::MoveAbsolute {
+        position,
+        velocity: vn,
+        buffer_mode,
+        ..
+    } = *next
+    else {
+        return 0.0;
+    };
+    let onward = cell_of(position, f) - cell;
+    if dist == 0 || onward == 0 || dist.signum() != onward.signum() {
+        return 0.0;
+    }
+    let m = match buffer_mode {
+        BufferMode::BlendingLow => v.min(vn),
+        BufferMode::BlendingPrevious => v,
+        BufferMode::BlendingNext => vn,
+        BufferMode::BlendingHigh => v.max(vn),
+        BufferMode::Aborting | BufferMode::Buffered => 0.0,
+    };
+    m * dist.signum() as f64
+}
+
+impl HostAxis {
+    /// Several requests due together, planned one after the other for the same swap tick
+    /// `at` (a move and the blending move queued behind it are planned as one program): the
+    /// change, if any request was taken, and the refused ones.
+    pub fn plan_batch(
+        &self,
+        at: u64,
+        reqs: &[Request],
+    ) -> (Option<Change>, Vec<(Request, Refusal)>) {
+        let mut work = self.clone();
+        let (mut aborts, mut notes, mut refused) = (Vec::new(), Vec::new(), Vec::new());
+        for &r in reqs {
+            match work.plan_change(at, r) {
+                Ok(c) => {
+                    aborts.extend(c.aborts.iter().copied());
+                    notes.extend(c.notes.iter().cloned());
+                    work.apply(c);
+                }
+                Err(e) => refused.push((r, e)),
+            }
+        }
+        if refused.len() == reqs.len() {
+            return (None, refused);
+        }
+        let f = &self.settings.format;
+        let change = Change {
+            at,
+            program: work.timeline.program_from(at, f),
+            timeline: work.timeline,
+            aborts,
+            notes,
+            override_factor: work.override_factor,
+        };
+        (Some(change), refused)
+    }
+}

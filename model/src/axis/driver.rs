@@ -1,0 +1,569 @@
+//! Runs a timed script of motion commands on a board over a [`Link`]: every change is
+//! planned from the exact state at a swap tick chosen ahead of the link's measured latency,
+//! uploaded and armed with SWAP_AT; every READ_STATE (one per poll) is compared bit for bit
+//! with the state the host predicts for its tick.
+//!
+//! The board's time base is the clock: a script's times count from the tick of its first
+//! READ_STATE. The latency of a command is the time from the tick it was due to the first tick
+//! that obeys it (its swap tick).
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::chain::ChainState;
+use crate::protocol::{Command, Reason, Reply, StateReply};
+
+use super::compose::{Refusal, Request};
+use super::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
+
+/// A board the host talks to.
+pub trait Link {
+    /// Sends `c` and returns the board's reply (a lost reply is retried inside).
+    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError>;
+    /// Lets about `ticks` board ticks pass.
+    fn wait(&mut self, ticks: u64);
+    /// The host's clock in board ticks (a virtual board: its clocks over the tick divider;
+    /// a serial port: wall time over Ts).
+    fn host_ticks(&self) -> f64;
+    /// Board ticks one byte takes on the wire (10 bits at the baud rate).
+    fn byte_ticks(&self) -> f64;
+}
+
+/// The link failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{0}")]
+pub struct LinkError(pub String);
+
+/// What a script event does.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Action {
+    /// A motion command.
+    Command(MotionCommand),
+    /// The feed override (0–2).
+    Override {
+        /// Factor.
+        r#override: f64,
+    },
+}
+
+/// One timed event.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Time from the script's start (ms).
+    pub at_ms: f64,
+    /// What happens.
+    #[serde(flatten)]
+    pub action: Action,
+}
+
+/// Run options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunOptions {
+    /// Status poll period (ms), also the watchdog's food.
+    pub poll_ms: f64,
+    /// Longest run after the last event (ms) before the run ends with commands still busy
+    /// (a held velocity).
+    pub settle_ms: f64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            poll_ms: 2.0,
+            settle_ms: 10_000.0,
+        }
+    }
+}
+
+/// One program swap.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SwapRecord {
+    /// The event (index in the script).
+    pub event: usize,
+    /// The swap tick.
+    pub tick: u64,
+    /// Ticks from the event's due tick to the swap tick: the command's latency.
+    pub latency_ticks: u64,
+    /// Segments uploaded.
+    pub segments: usize,
+    /// SWAP_AT refused as late before this one was taken.
+    pub late_retries: u32,
+}
+
+/// What a run did.
+#[derive(Clone, Debug)]
+pub struct RunReport {
+    /// The axis at the end (commands, outcomes, the timeline played).
+    pub axis: HostAxis,
+    /// Which command each event gave (None: an override).
+    pub event_commands: Vec<Option<usize>>,
+    /// Override events refused (event index, why).
+    pub refused_overrides: Vec<(usize, AxisErrorId)>,
+    /// Program swaps.
+    pub swaps: Vec<SwapRecord>,
+    /// The tick the script started on.
+    pub start_tick: u64,
+    /// The last READ_STATE.
+    pub last: StateReply,
+    /// READ_STATE replies compared with the prediction (all equal, or the run failed).
+    pub checks: u64,
+    /// Swaps that uploaded the rest of a change longer than the program memory.
+    pub extensions: u32,
+}
+
+/// Why a run stopped.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum RunError {
+    /// The link failed.
+    #[error("link: {0}")]
+    Link(#[from] LinkError),
+    /// The board answered what a run cannot go on from.
+    #[error("the board answered {what}: {detail}")]
+    Board {
+        /// The command.
+        what: &'static str,
+        /// The answer.
+        detail: String,
+    },
+    /// The board's registers differ from the host's prediction (a stop was sent).
+    #[error("the board's registers at tick {tick} are {got:?}, the plan says {want:?}: stopped")]
+    Diverged {
+        /// The tick.
+        tick: u64,
+        /// Read.
+        got: Box<ChainState>,
+        /// Predicted.
+        want: Box<ChainState>,
+    },
+    /// The axis was moving when the script began.
+    #[error("the axis is moving (v, a or j ≠ 0): start a script at rest")]
+    Moving,
+}
+
+/// Reads the state.
+pub fn read_state<L: Link>(link: &mut L) -> Result<StateReply, RunError> {
+    match link.ask(&Command::ReadState)? {
+        Reply::State(s) => Ok(s),
+        r => Err(RunError::Board {
+            what: "READ_STATE",
+            detail: format!("{r:?}"),
+        }),
+    }
+}
+
+fn regs(s: &StateReply) -> ChainState {
+    ChainState {
+        x: s.x,
+        v: s.v,
+        a: s.a,
+        j: s.j,
+    }
+}
+
+/// Ticks in `ms` milliseconds at Ts.
+fn ticks_of(ms: f64, ts: f64) -> u64 {
+    (ms * 1e-3 / ts).round().max(0.0) as u64
+}
+
+fn too_slow() -> RunError {
+    RunError::Board {
+        what: "SWAP_AT",
+        detail: "LATE again and again: the link is too slow for the swaps this script needs".into(),
+    }
+}
+
+/// Ticks of lead beyond the upload's estimate.
+const SAFETY: u64 = 20;
+
+/// Bytes of `c`'s frame.
+fn frame_bytes(c: &Command, f: &crate::format::Format) -> usize {
+    c.to_frame(0, f).to_bytes().len()
+}
+
+/// SWAP_AT attempts before a command is given up as the link being too slow.
+const LATE_TRIES: u32 = 8;
+
+struct Runner<'l, L: Link> {
+    link: &'l mut L,
+    axis: HostAxis,
+    checks: u64,
+    last: StateReply,
+    /// Host ticks a request takes beyond its bytes on the wire, the largest seen.
+    overhead: f64,
+    /// The armed swap's tick, until it has passed.
+    armed: Option<u64>,
+    /// The tick the board's program (as armed) ends on.
+    covered: u64,
+    /// Swaps that only uploaded the rest of a long change.
+    extensions: u32,
+}
+
+impl<L: Link> Runner<'_, L> {
+    /// READ_STATE, compared with the prediction; the axis's outcomes updated.
+    fn poll(&mut self) -> Result<StateReply, RunError> {
+        let t0 = self.link.host_ticks();
+        let s = read_state(self.link)?;
+        let wire = (frame_bytes(&Command::ReadState, &self.axis.settings.format)
+            + Reply::State(s).to_frame(0).to_bytes().len()) as f64
+            * self.link.byte_ticks();
+        self.overhead = self.overhead.max(self.link.host_ticks() - t0 - wire);
+        let want = self
+            .axis
+            .timeline
+            .state_at(s.ticks, &self.axis.settings.format);
+        if regs(&s) != want {
+            let _ = self.link.ask(&Command::Stop);
+            return Err(RunError::Diverged {
+                tick: s.ticks,
+                got: Box::new(regs(&s)),
+                want: Box::new(want),
+            });
+        }
+        self.checks += 1;
+        self.axis.update(s.ticks);
+        if self.armed.is_some_and(|t| s.ticks >= t) {
+            self.armed = None;
+        }
+        self.last = s;
+        Ok(s)
+    }
+
+    fn expect_ack(&mut self, c: &Command) -> Result<Result<(), Reason>, RunError> {
+        match self.link.ask(c)? {
+            Reply::Ack { .. } => Ok(Ok(())),
+            Reply::Nak { reason, .. } => Ok(Err(reason)),
+            r => Err(RunError::Board {
+                what: "an upload",
+                detail: format!("{r:?}"),
+            }),
+        }
+    }
+
+    /// Plans, uploads and arms the requests due together (first event `event`, due on tick
+    /// `due`): the swap's record (None when none was needed) and the requests refused.
+    #[allow(clippy::type_complexity)]
+    fn change(
+        &mut self,
+        event: usize,
+        due: u64,
+        reqs: &[Request],
+    ) -> Result<(Option<SwapRecord>, Vec<(Request, Refusal)>), RunError> {
+        let mut late_retries = 0;
+        let mut margin = 1.0;
+        loop {
+            // An armed swap must have passed before the standby bank is written again.
+            if let Some(t) = self.armed {
+                let now = self.poll()?.ticks;
+                if now < t {
+                    self.link.wait(t - now);
+                }
+                self.poll()?;
+                continue;
+            }
+            let now = self.poll()?.ticks;
+            let f = self.axis.settings.format;
+            // The lead: the upload's time on the wire and the link's measured overhead per
+            // request, with a margin; planned again while the program found needs more.
+            let mut guess = self.axis.timeline.program_from(now, &f);
+            let mut tries = 0;
+            let (at, c, refused) = loop {
+                let lead = (self.upload_ticks(&guess) * 1.25 * margin).ceil() as u64 + SAFETY;
+                let at = now + lead;
+                tries += 1;
+                match self.axis.plan_batch(at, reqs) {
+                    (None, refused) => return Ok((None, refused)),
+                    (Some(c), refused) => {
+                        if self.upload_ticks(&c.program) * 1.25 * margin <= (lead - SAFETY) as f64
+                            || tries == 4
+                        {
+                            break (at, c, refused);
+                        }
+                        guess = c.program;
+                    }
+                }
+            };
+            if c.program.segments.is_empty() {
+                // Nothing plays from `at` (the axis rests before it): no swap is needed.
+                self.axis.apply(c);
+                return Ok((None, refused));
+            }
+            match self.arm(at, &c.program)? {
+                Ok(()) => {
+                    let segments = c.program.segments.len();
+                    self.axis.apply(c);
+                    let record = SwapRecord {
+                        event,
+                        tick: at,
+                        latency_ticks: at.saturating_sub(due),
+                        segments,
+                        late_retries,
+                    };
+                    return Ok((Some(record), refused));
+                }
+                Err(()) if late_retries < LATE_TRIES => {
+                    // Nothing changed on the board: plan again with more lead.
+                    late_retries += 1;
+                    margin *= 2.0;
+                }
+                Err(()) => return Err(too_slow()),
+            }
+        }
+    }
+
+    /// Uploads `program` and arms its swap at `at`: `Err(())` when SWAP_AT came too late
+    /// (nothing changed on the board).
+    fn arm(
+        &mut self,
+        at: u64,
+        program: &crate::program::Program,
+    ) -> Result<Result<(), ()>, RunError> {
+        let refused = |what: &'static str, reason: Reason| RunError::Board {
+            what,
+            detail: reason.name().to_string(),
+        };
+        for (k, s) in program.segments.iter().enumerate() {
+            let cmd = Command::LoadSegment {
+                index: k as u8,
+                segment: *s,
+            };
+            self.expect_ack(&cmd)?
+                .map_err(|r| refused("LOAD_SEGMENT", r))?;
+        }
+        let count = program.segments.len() as u8;
+        self.expect_ack(&Command::Commit { count })?
+            .map_err(|r| refused("COMMIT", r))?;
+        match self.expect_ack(&Command::SwapAt { tick: at })? {
+            Ok(()) => {
+                self.armed = Some(at);
+                self.covered = at + program.total_ticks();
+                Ok(Ok(()))
+            }
+            Err(Reason::Late) => Ok(Err(())),
+            Err(r) => Err(refused("SWAP_AT", r)),
+        }
+    }
+
+    /// When the timeline goes on past the program the board holds (a change longer than
+    /// the program memory), uploads the rest and swaps to it before the board's ends.
+    fn extend(&mut self) -> Result<(), RunError> {
+        let f = self.axis.settings.format;
+        let mut margin = 1.0;
+        for _ in 0..LATE_TRIES {
+            if self.armed.is_some()
+                || self
+                    .axis
+                    .timeline
+                    .program_from(self.covered, &f)
+                    .segments
+                    .is_empty()
+            {
+                return Ok(());
+            }
+            let now = self.last.ticks;
+            let full = self.axis.timeline.program_from(now, &f);
+            let at = now + (self.upload_ticks(&full) * 1.25 * margin).ceil() as u64 + SAFETY;
+            if at >= self.covered {
+                return Err(too_slow());
+            }
+            let program = self.axis.timeline.program_from(at, &f);
+            if self.arm(at, &program)?.is_ok() {
+                self.extensions += 1;
+                return Ok(());
+            }
+            margin *= 2.0;
+            self.poll()?;
+        }
+        Err(too_slow())
+    }
+
+    /// Host ticks the upload of `p` takes: LOAD_SEGMENTs, COMMIT and SWAP_AT with their
+    /// acknowledgements on the wire, and the measured overhead per request.
+    fn upload_ticks(&self, p: &crate::program::Program) -> f64 {
+        let f = &self.axis.settings.format;
+        let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
+        let load = p.segments.first().map_or(0, |s| {
+            frame_bytes(
+                &Command::LoadSegment {
+                    index: 0,
+                    segment: *s,
+                },
+                f,
+            )
+        });
+        let commit = frame_bytes(&Command::Commit { count: 0 }, f);
+        let swap = frame_bytes(&Command::SwapAt { tick: 0 }, f);
+        let n = p.segments.len();
+        let bytes = n * (load + ack) + commit + swap + 2 * ack;
+        bytes as f64 * self.link.byte_ticks() + (n + 2) as f64 * self.overhead
+    }
+
+    /// True when nothing will move any more without a new command.
+    fn settled(&self, now: u64) -> bool {
+        let t = &self.axis.timeline;
+        now >= t.end_tick()
+            && self.armed.is_none()
+            && t.parts
+                .last()
+                .is_none_or(|p| !matches!(p.goal, Goal::Velocity(v) if v != 0.0))
+    }
+}
+
+/// Runs `script` (events in time order) on the board behind `link`, which must be powered,
+/// at rest and configured (stop limits) for the axis's format.
+pub fn run<L: Link>(
+    link: &mut L,
+    settings: AxisSettings,
+    script: &[Event],
+    opts: &RunOptions,
+) -> Result<RunReport, RunError> {
+    let first = read_state(link)?;
+    if (first.v, first.a, first.j) != (0, 0, 0) {
+        return Err(RunError::Moving);
+    }
+    let ts = settings.format.ts;
+    let mut r = Runner {
+        link,
+        axis: HostAxis::new(settings, first.ticks, regs(&first)),
+        checks: 0,
+        last: first,
+        overhead: 0.0,
+        armed: None,
+        covered: first.ticks,
+        extensions: 0,
+    };
+    let start = first.ticks;
+    let poll = ticks_of(opts.poll_ms, ts).max(1);
+    let mut swaps = Vec::new();
+    let mut event_commands = Vec::new();
+    let mut refused_overrides = Vec::new();
+    let mut next = 0;
+    let last_due = script
+        .last()
+        .map_or(start, |e| start + ticks_of(e.at_ms, ts));
+    let end_by = last_due + ticks_of(opts.settle_ms, ts);
+    loop {
+        let now = r.poll()?.ticks;
+        r.extend()?;
+        if let Some(e) = script.get(next) {
+            let due = start + ticks_of(e.at_ms, ts);
+            if now >= due {
+                // Every event due by now, planned together.
+                let first = next;
+                let mut reqs = Vec::new();
+                while let Some(e) = script.get(next) {
+                    if start + ticks_of(e.at_ms, ts) > now {
+                        break;
+                    }
+                    match e.action {
+                        Action::Command(c) => {
+                            let k = r.axis.submit(c);
+                            event_commands.push(Some(k));
+                            if !r.axis.commands[k].outcome.is_final() {
+                                reqs.push((next, Request::Command(k)));
+                            }
+                        }
+                        Action::Override { r#override } => {
+                            event_commands.push(None);
+                            reqs.push((next, Request::Override(r#override)));
+                        }
+                    }
+                    next += 1;
+                }
+                if reqs.is_empty() {
+                    continue;
+                }
+                let only: Vec<Request> = reqs.iter().map(|(_, q)| *q).collect();
+                let (swap, refused) = r.change(first, due, &only)?;
+                swaps.extend(swap);
+                // A refused command is in Error; a refused override changes nothing.
+                for (q, refusal) in refused {
+                    match q {
+                        Request::Command(k) => {
+                            r.axis.commands[k].outcome = Outcome::Error(refusal.error)
+                        }
+                        Request::Override(_) => {
+                            let ev = reqs
+                                .iter()
+                                .find(|(_, x)| *x == q)
+                                .map_or(first, |(e, _)| *e);
+                            refused_overrides.push((ev, refusal.error))
+                        }
+                    }
+                }
+                continue;
+            }
+            r.link.wait(poll.min(due - now));
+            continue;
+        }
+        if r.settled(now) || now >= end_by {
+            break;
+        }
+        r.link.wait(poll);
+    }
+    r.poll()?;
+    Ok(RunReport {
+        checks: r.checks,
+        extensions: r.extensions,
+        last: r.last,
+        axis: r.axis,
+        event_commands,
+        refused_overrides,
+        swaps,
+        start_tick: start,
+    })
+}
+
+/// Writes the controlled stop's limits (raw) and powers the axis on (POWER 1; an axis already
+/// on is left so), as a run wants it.
+pub fn power_up<L: Link>(link: &mut L, stop: crate::stop::StopLimits) -> Result<(), RunError> {
+    use crate::protocol::Param;
+    for c in [
+        Command::Configure {
+            param: Param::StopJerk,
+            value: stop.jerk,
+        },
+        Command::Configure {
+            param: Param::StopAccel,
+            value: stop.accel,
+        },
+        Command::Power { on: true },
+    ] {
+        match link.ask(&c)? {
+            Reply::Ack { .. }
+            | Reply::Nak {
+                reason: Reason::NotDisabled,
+                ..
+            } => {}
+            r => {
+                return Err(RunError::Board {
+                    what: "the set-up (CONFIGURE, POWER)",
+                    detail: format!("{r:?}"),
+                })
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Raw stop limits from a physical deceleration and jerk (unit/s², unit/s³) in `format`,
+/// each at least one LSB and at most what a CONFIGURE can set.
+pub fn stop_limits(
+    deceleration: f64,
+    jerk: f64,
+    format: &crate::format::Format,
+) -> crate::stop::StopLimits {
+    use crate::format::Quantity;
+    use crate::protocol::Param;
+    let raw = |v: f64, q: Quantity, p: Param| {
+        let r = crate::planner::fmath::floor(v * format.scale(q));
+        if r >= p.max() as f64 {
+            p.max()
+        } else {
+            (r as i128).max(1)
+        }
+    };
+    let jerk = raw(jerk, Quantity::Jerk, Param::StopJerk);
+    let accel = raw(deceleration, Quantity::Acceleration, Param::StopAccel).max(jerk);
+    crate::stop::StopLimits { jerk, accel }
+}

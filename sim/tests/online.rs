@@ -1,0 +1,316 @@
+//! The PLCopen host axis on the virtual board (device model, the design's real clock and UART):
+//! every buffer mode, MC_Halt, MC_MoveVelocity and the override, each run checked on every
+//! poll against the host's prediction by the driver, and here against an independent tick by
+//! tick replay of what the board played.
+
+use snapgen_model::axis::driver::{
+    power_up, run, stop_limits, Action, Event, RunOptions, RunReport,
+};
+use snapgen_model::axis::{AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
+use snapgen_model::device::Design;
+use snapgen_model::online::OnlineOrder;
+use snapgen_model::timing::Timing;
+use snapgen_model::{ChainState, DEFAULT_FORMAT};
+use snapgen_sim::board::VirtualBoard;
+use snapgen_sim::host_link::BoardLink;
+
+fn design() -> Design {
+    Design::from_timing(&DEFAULT_FORMAT, &Timing::default()).unwrap()
+}
+
+fn mv(position: f64, velocity: f64, mode: BufferMode) -> MotionCommand {
+    MotionCommand::MoveAbsolute {
+        position,
+        velocity,
+        acceleration: 4000.0,
+        deceleration: 3000.0,
+        jerk: 500_000.0,
+        buffer_mode: mode,
+    }
+}
+
+fn at(ms: f64, c: MotionCommand) -> Event {
+    Event {
+        at_ms: ms,
+        action: Action::Command(c),
+    }
+}
+
+fn play(script: &[Event], order: OnlineOrder) -> RunReport {
+    let d = design();
+    let mut link = BoardLink::new(VirtualBoard::model(&d));
+    power_up(&mut link, stop_limits(3000.0, 500_000.0, &d.format)).unwrap();
+    let settings = AxisSettings {
+        format: d.format,
+        order,
+    };
+    run(&mut link, settings, script, &RunOptions::default()).unwrap()
+}
+
+fn outcomes(r: &RunReport) -> Vec<Outcome> {
+    r.axis.commands.iter().map(|c| c.outcome.clone()).collect()
+}
+
+/// Replays the timeline tick by tick with the chain (not the closed form the host predicts
+/// with): the last state, and whether the velocity ever changed sign, and the largest |v|.
+fn replay(r: &RunReport) -> (ChainState, bool, i128) {
+    let f = r.axis.settings.format;
+    let t = &r.axis.timeline;
+    let mut s = t.origin.1;
+    let mut reversed = false;
+    let mut sign = 0;
+    let mut vmax = 0;
+    let mut tick = t.origin.0;
+    for p in &t.parts {
+        // Between parts (before the first, after a move that ended at rest or holds a
+        // velocity) the chain runs with snap 0.
+        assert!(p.start_tick >= tick, "parts do not overlap");
+        for _ in tick..p.start_tick {
+            s = s.step(0, &f.widths);
+        }
+        tick = p.start_tick;
+        assert_eq!(p.start, s, "each part starts where the one before ended");
+        for seg in &p.program.segments {
+            for _ in 0..seg.ticks {
+                s = s.step(seg.snap, &f.widths);
+                if s.v != 0 {
+                    if sign != 0 && s.v.signum() != sign {
+                        reversed = true;
+                    }
+                    sign = s.v.signum();
+                }
+                vmax = vmax.max(s.v.abs());
+            }
+        }
+        tick += p.program.total_ticks();
+        assert_eq!(s, p.end, "a part ends in the state it was planned to");
+    }
+    (s, reversed, vmax)
+}
+
+fn cell(mm: f64) -> i128 {
+    (mm / DEFAULT_FORMAT.position_lsb).round() as i128
+}
+
+/// The board's registers at the end equal the replay's, at rest on `mm`.
+fn lands_on(r: &RunReport, mm: f64) {
+    let (end, _, _) = replay(r);
+    let last = r.last;
+    assert_eq!((last.x, last.v, last.a, last.j), (end.x, 0, 0, 0));
+    assert_eq!(DEFAULT_FORMAT.output_lsb(last.x), cell(mm));
+    assert!(
+        r.checks > 10,
+        "the driver compared the board's state {} times",
+        r.checks
+    );
+}
+
+#[test]
+fn an_aborting_move_takes_over_mid_move() {
+    let r = play(
+        &[
+            at(0.0, mv(20.0, 200.0, BufferMode::Aborting)),
+            at(40.0, mv(5.0, 150.0, BufferMode::Aborting)),
+        ],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::CommandAborted, Outcome::Done]);
+    assert_eq!(r.swaps.len(), 2);
+    lands_on(&r, 5.0);
+}
+
+#[test]
+fn a_buffered_move_follows_at_rest() {
+    let r = play(
+        &[
+            at(0.0, mv(10.0, 200.0, BufferMode::Aborting)),
+            at(10.0, mv(-4.0, 100.0, BufferMode::Buffered)),
+        ],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::Done, Outcome::Done]);
+    // The first ends at rest on its target before the second begins.
+    let p = &r.axis.timeline.parts;
+    let first = p.iter().rev().find(|p| p.command == 0).unwrap();
+    assert_eq!((first.end.v, first.end.a, first.end.j), (0, 0, 0));
+    assert_eq!(DEFAULT_FORMAT.output_lsb(first.end.x), cell(10.0));
+    lands_on(&r, -4.0);
+}
+
+#[test]
+fn every_blending_mode_passes_the_first_target_at_its_velocity() {
+    // (mode, first velocity, second velocity, expected blend velocity)
+    for (mode, v1, v2, vb) in [
+        (BufferMode::BlendingLow, 200.0, 100.0, 100.0),
+        (BufferMode::BlendingPrevious, 200.0, 100.0, 200.0),
+        (BufferMode::BlendingNext, 100.0, 150.0, 150.0),
+        (BufferMode::BlendingHigh, 100.0, 150.0, 150.0),
+    ] {
+        let r = play(
+            &[
+                at(0.0, mv(30.0, v1, BufferMode::Aborting)),
+                at(0.0, mv(45.0, v2, mode)),
+            ],
+            OnlineOrder::Three,
+        );
+        assert_eq!(outcomes(&r), [Outcome::Done, Outcome::Done], "{mode:?}");
+        let first = r
+            .axis
+            .timeline
+            .parts
+            .iter()
+            .rev()
+            .find(|p| p.command == 0)
+            .unwrap();
+        assert_eq!(
+            first.goal,
+            Goal::Position {
+                cell: cell(30.0),
+                velocity: vb
+            },
+            "{mode:?}"
+        );
+        let v = DEFAULT_FORMAT.to_physical(snapgen_model::Quantity::Velocity, first.end.v);
+        assert!(
+            (v - vb).abs() < 1e-9,
+            "{mode:?}: {v} at the blend point, want {vb}"
+        );
+        assert_eq!((first.end.a, first.end.j), (0, 0));
+        assert_eq!(DEFAULT_FORMAT.output_lsb(first.end.x), cell(30.0));
+        let (_, reversed, _) = replay(&r);
+        assert!(!reversed, "{mode:?}");
+        lands_on(&r, 45.0);
+    }
+}
+
+#[test]
+fn a_blend_into_a_reversal_stops_at_the_first_target() {
+    let r = play(
+        &[
+            at(0.0, mv(30.0, 200.0, BufferMode::Aborting)),
+            at(5.0, mv(2.0, 100.0, BufferMode::BlendingHigh)),
+        ],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::Done, Outcome::Done]);
+    let first = r
+        .axis
+        .timeline
+        .parts
+        .iter()
+        .rev()
+        .find(|p| p.command == 0)
+        .unwrap();
+    assert_eq!(first.end.v, 0);
+    lands_on(&r, 2.0);
+}
+
+#[test]
+fn an_override_cut_slows_without_reversal_and_still_lands() {
+    for order in [OnlineOrder::Three, OnlineOrder::Two] {
+        let r = play(
+            &[
+                at(0.0, mv(30.0, 300.0, BufferMode::Aborting)),
+                Event {
+                    at_ms: 60.0,
+                    action: Action::Override { r#override: 0.1 },
+                },
+                Event {
+                    at_ms: 120.0,
+                    action: Action::Override { r#override: 2.0 },
+                },
+            ],
+            order,
+        );
+        assert_eq!(outcomes(&r), [Outcome::Done], "{order:?}");
+        let (_, reversed, vmax) = replay(&r);
+        assert!(!reversed, "{order:?}: the velocity changed sign");
+        // 200 % of 300 mm/s at most.
+        let v = DEFAULT_FORMAT.to_physical(snapgen_model::Quantity::Velocity, vmax);
+        assert!(v <= 600.0 + 1e-9, "{order:?}: {v} mm/s");
+        lands_on(&r, 30.0);
+    }
+}
+
+#[test]
+fn an_override_of_zero_pauses_on_the_path_and_resumes() {
+    let r = play(
+        &[
+            at(0.0, mv(20.0, 200.0, BufferMode::Aborting)),
+            Event {
+                at_ms: 30.0,
+                action: Action::Override { r#override: 0.0 },
+            },
+            Event {
+                at_ms: 150.0,
+                action: Action::Override { r#override: 1.0 },
+            },
+        ],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::Done]);
+    // It came to rest short of the target, then went on.
+    let paused = r.axis.timeline.parts.iter().find(|p| p.paused).unwrap();
+    assert_eq!((paused.end.v, paused.end.a, paused.end.j), (0, 0, 0));
+    assert!(DEFAULT_FORMAT.output_lsb(paused.end.x) < cell(20.0));
+    let (_, reversed, _) = replay(&r);
+    assert!(!reversed);
+    lands_on(&r, 20.0);
+}
+
+#[test]
+fn a_halt_aborts_and_stops_and_a_velocity_is_held_until_aborted() {
+    let r = play(
+        &[
+            at(0.0, mv(50.0, 300.0, BufferMode::Aborting)),
+            at(
+                40.0,
+                MotionCommand::Halt {
+                    deceleration: 2000.0,
+                    jerk: 100_000.0,
+                },
+            ),
+        ],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::CommandAborted, Outcome::Done]);
+    let (end, reversed, _) = replay(&r);
+    assert!(!reversed);
+    assert_eq!((r.last.x, r.last.v, r.last.a, r.last.j), (end.x, 0, 0, 0));
+
+    let vel = MotionCommand::MoveVelocity {
+        velocity: -80.0,
+        acceleration: 4000.0,
+        deceleration: 3000.0,
+        jerk: 500_000.0,
+    };
+    let r = play(
+        &[at(0.0, vel), at(60.0, mv(1.0, 100.0, BufferMode::Aborting))],
+        OnlineOrder::Three,
+    );
+    assert_eq!(outcomes(&r), [Outcome::CommandAborted, Outcome::Done]);
+    lands_on(&r, 1.0);
+}
+
+#[test]
+fn bad_inputs_are_errors_and_move_nothing() {
+    let r = play(
+        &[
+            at(0.0, mv(5.0, -1.0, BufferMode::Aborting)),
+            Event {
+                at_ms: 1.0,
+                action: Action::Override { r#override: 2.5 },
+            },
+            at(2.0, mv(1e9, 100.0, BufferMode::Aborting)),
+        ],
+        OnlineOrder::Three,
+    );
+    let o = outcomes(&r);
+    assert!(
+        matches!(o[0], Outcome::Error(_)) && matches!(o[1], Outcome::Error(_)),
+        "{o:?}"
+    );
+    assert_eq!(r.refused_overrides.len(), 1);
+    assert!(r.swaps.is_empty());
+    assert_eq!((r.last.v, r.last.a, r.last.j), (0, 0, 0));
+}
