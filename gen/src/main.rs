@@ -11,8 +11,10 @@ mod demo;
 mod experiment;
 mod fpga;
 mod hw;
+mod online;
 mod plot;
 mod report;
+mod scenario;
 mod send;
 mod trace;
 mod yosys;
@@ -132,6 +134,46 @@ enum Command {
         /// captured fabric outputs ("CLOCK:SIGNAL:BIT").
         #[arg(long, hide = true)]
         inject_fault: Option<String>,
+    },
+    /// Play a timed script of PLCopen commands (MC_MoveAbsolute with its buffer modes,
+    /// MC_MoveVelocity, MC_Halt, the feed override) through the host axis on a board: every
+    /// change planned from the exact state at a swap tick ahead of the link's latency and
+    /// swapped in there; every state read checked bit for bit against the plan
+    /// (docs/ONLINE.md).
+    Online {
+        /// The script (TOML, docs/ONLINE.md).
+        #[arg(
+            long,
+            conflicts_with = "scenario",
+            required_unless_present = "scenario"
+        )]
+        script: Option<PathBuf>,
+        /// A built-in scenario instead of a script.
+        #[arg(long, value_enum)]
+        scenario: Option<scenario::Scenario>,
+        /// The scenario's jerk (unit/s³) [seed002: 50000].
+        #[arg(long, requires = "scenario")]
+        jerk: Option<f64>,
+        /// The virtual board: the device model, or the Verilated I/O top with the device model
+        /// in lockstep (every output compared on every clock).
+        #[arg(long, value_enum, default_value = "model", conflicts_with = "port")]
+        board: online::BoardKind,
+        /// A real board's serial port instead of a virtual board.
+        #[arg(long)]
+        port: Option<String>,
+        /// Baud rate: the virtual board's UART (its design) or the port's.
+        #[arg(long, default_value_t = 115_200)]
+        baud: u32,
+        /// Write the per-tick integer trace (tick, x, v, a, j, position LSB).
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Plot position, velocity, acceleration and jerk with the events marked.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Print one JSON object (commands and outcomes, replans, ticks, final and target
+        /// position, final registers, mismatches) instead of the summary.
+        #[arg(long)]
+        json: bool,
     },
     /// Plan a move and run it on a board over a serial port: read the board's identity, plan
     /// with its Ts and format from its exact registers, configure (read back), upload, start,
@@ -647,6 +689,42 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     println!("waves: {}", v.display());
                 }
                 return Err(anyhow::Error::new(Mismatched));
+            }
+        }
+        Command::Online {
+            script,
+            scenario,
+            jerk,
+            board,
+            port,
+            baud,
+            csv,
+            svg,
+            json,
+        } => {
+            let (script, title) = match (script, scenario) {
+                (Some(path), _) => {
+                    let title = format!("snapgen online {}", path.display());
+                    (online::Script::read(&path)?, title)
+                }
+                (None, Some(s)) => (s.script(jerk)?, s.title(jerk)),
+                (None, None) => anyhow::bail!("give --script FILE or --scenario NAME"),
+            };
+            let target = online::Target { board, port, baud };
+            let played = online::play(script, &target)?;
+            if json {
+                println!("{}", online::json(&played));
+            } else {
+                println!("{title}\n{}", online::describe(&played));
+            }
+            if let Some(path) = csv {
+                online::write_csv(&played, &path)?;
+            }
+            if let Some(path) = svg {
+                online::write_svg(&played, &title, &path)?;
+            }
+            if played.mismatches.unwrap_or(0) > 0 {
+                anyhow::bail!("the fabric and the model disagree");
             }
         }
         Command::Send {

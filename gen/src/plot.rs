@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use plotters::prelude::*;
-use snapgen_model::{Plan, Quantity as Physical, Trace};
+use snapgen_model::{ChainState, Format, Plan, Program, Quantity as Physical, Trace};
 use snapgen_plant::fast::LoopSample;
 
 /// Number of time buckets drawn.
@@ -19,12 +19,11 @@ struct Bucket {
     hi: [f64; 5],
 }
 
-fn buckets(plan: &Plan) -> Vec<Bucket> {
-    let f = plan.format;
-    let x0 = f.position_physical(plan.start.x);
-    let per = (plan.ticks_total() / BUCKETS).max(1);
+fn buckets(program: &Program, start: ChainState, f: &Format) -> Vec<Bucket> {
+    let x0 = f.position_physical(start.x);
+    let per = (program.total_ticks() / BUCKETS).max(1);
     let mut out: Vec<Bucket> = Vec::new();
-    for t in Trace::new(&plan.program, plan.start, f.widths) {
+    for t in Trace::new(program, start, f.widths) {
         let s = t.state;
         let vals = [
             f.position_physical(s.x) - x0,
@@ -56,8 +55,21 @@ pub type PlotError = Box<dyn std::error::Error + Send + Sync>;
 
 /// Draws the five panels into `path`.
 pub fn write_svg(plan: &Plan, title: &str, path: &Path) -> Result<(), PlotError> {
-    let data = buckets(plan);
-    let t_end = (plan.ticks_total() as f64 * plan.format.ts).max(plan.format.ts);
+    write_program_svg(&plan.program, plan.start, &plan.format, title, &[], path)
+}
+
+/// Draws the five panels of `program` played from `start` into `path`, with a vertical line
+/// at each of `events` (s from the start).
+pub fn write_program_svg(
+    program: &Program,
+    start: ChainState,
+    format: &Format,
+    title: &str,
+    events: &[f64],
+    path: &Path,
+) -> Result<(), PlotError> {
+    let data = buckets(program, start, format);
+    let t_end = (program.total_ticks() as f64 * format.ts).max(format.ts);
     let root = SVGBackend::new(path, (1000, 1200)).into_drawing_area();
     root.fill(&WHITE)?;
     let (head, body) = root.split_vertically(40);
@@ -96,6 +108,12 @@ pub fn write_svg(plan: &Plan, title: &str, path: &Path) -> Result<(), PlotError>
         let color = colors[i];
         chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.hi[i])), color))?;
         chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.lo[i])), color))?;
+        for &t in events {
+            chart.draw_series(LineSeries::new(
+                [(t, lo - pad), (t, hi + pad)],
+                BLACK.mix(0.4),
+            ))?;
+        }
     }
     root.present()?;
     Ok(())

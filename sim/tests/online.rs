@@ -32,6 +32,7 @@ fn mv(position: f64, velocity: f64, mode: BufferMode) -> MotionCommand {
 fn at(ms: f64, c: MotionCommand) -> Event {
     Event {
         at_ms: ms,
+        at_position: None,
         action: Action::Command(c),
     }
 }
@@ -212,10 +213,12 @@ fn an_override_cut_slows_without_reversal_and_still_lands() {
             &[
                 at(0.0, mv(30.0, 300.0, BufferMode::Aborting)),
                 Event {
+                    at_position: None,
                     at_ms: 60.0,
                     action: Action::Override { r#override: 0.1 },
                 },
                 Event {
+                    at_position: None,
                     at_ms: 120.0,
                     action: Action::Override { r#override: 2.0 },
                 },
@@ -238,10 +241,12 @@ fn an_override_of_zero_pauses_on_the_path_and_resumes() {
         &[
             at(0.0, mv(20.0, 200.0, BufferMode::Aborting)),
             Event {
+                at_position: None,
                 at_ms: 30.0,
                 action: Action::Override { r#override: 0.0 },
             },
             Event {
+                at_position: None,
                 at_ms: 150.0,
                 action: Action::Override { r#override: 1.0 },
             },
@@ -298,6 +303,7 @@ fn bad_inputs_are_errors_and_move_nothing() {
         &[
             at(0.0, mv(5.0, -1.0, BufferMode::Aborting)),
             Event {
+                at_position: None,
                 at_ms: 1.0,
                 action: Action::Override { r#override: 2.5 },
             },

@@ -52,6 +52,10 @@ pub enum Action {
 pub struct Event {
     /// Time from the script's start (ms).
     pub at_ms: f64,
+    /// And, when given, not before the axis has reached this position (unit), moving toward
+    /// it from where the script began (a tangent move entering the buffer at a point).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at_position: Option<f64>,
     /// What happens.
     #[serde(flatten)]
     pub action: Action,
@@ -79,11 +83,11 @@ impl Default for RunOptions {
 /// One program swap.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SwapRecord {
-    /// The event (index in the script).
-    pub event: usize,
+    /// The events it realised (indices in the script; several when they were due together).
+    pub events: Vec<usize>,
     /// The swap tick.
     pub tick: u64,
-    /// Ticks from the event's due tick to the swap tick: the command's latency.
+    /// Ticks from the first event's due tick to the swap tick: its latency.
     pub latency_ticks: u64,
     /// Segments uploaded.
     pub segments: usize,
@@ -240,12 +244,12 @@ impl<L: Link> Runner<'_, L> {
         }
     }
 
-    /// Plans, uploads and arms the requests due together (first event `event`, due on tick
-    /// `due`): the swap's record (None when none was needed) and the requests refused.
+    /// Plans, uploads and arms the requests due together (events `events`, the first due on
+    /// tick `due`): the swap's record (None when none was needed) and the requests refused.
     #[allow(clippy::type_complexity)]
     fn change(
         &mut self,
-        event: usize,
+        events: &[usize],
         due: u64,
         reqs: &[Request],
     ) -> Result<(Option<SwapRecord>, Vec<(Request, Refusal)>), RunError> {
@@ -293,7 +297,7 @@ impl<L: Link> Runner<'_, L> {
                     let segments = c.program.segments.len();
                     self.axis.apply(c);
                     let record = SwapRecord {
-                        event,
+                        events: events.to_vec(),
                         tick: at,
                         latency_ticks: at.saturating_sub(due),
                         segments,
@@ -433,6 +437,8 @@ pub fn run<L: Link>(
         extensions: 0,
     };
     let start = first.ticks;
+    let f = settings.format;
+    let home = f.position_physical(first.x);
     let poll = ticks_of(opts.poll_ms, ts).max(1);
     let mut swaps = Vec::new();
     let mut event_commands = Vec::new();
@@ -441,18 +447,32 @@ pub fn run<L: Link>(
     let last_due = script
         .last()
         .map_or(start, |e| start + ticks_of(e.at_ms, ts));
+    // A position trigger never reached ends the run at the settle time after the last event.
     let end_by = last_due + ticks_of(opts.settle_ms, ts);
     loop {
         let now = r.poll()?.ticks;
         r.extend()?;
+        let here = f.position_physical(r.last.x);
+        let due_by = |e: &Event| {
+            let reached = e.at_position.is_none_or(|p| {
+                let toward = (p - home).signum();
+                (here - p) * toward >= 0.0
+            });
+            (start + ticks_of(e.at_ms, ts) <= now && reached).then_some(now)
+        };
         if let Some(e) = script.get(next) {
-            let due = start + ticks_of(e.at_ms, ts);
-            if now >= due {
-                // Every event due by now, planned together.
+            if let Some(due) = due_by(e) {
+                // Every event due by now, planned together; a position trigger is due on the
+                // tick it was seen reached.
+                let due = if e.at_position.is_some() {
+                    due
+                } else {
+                    start + ticks_of(e.at_ms, ts)
+                };
                 let first = next;
                 let mut reqs = Vec::new();
                 while let Some(e) = script.get(next) {
-                    if start + ticks_of(e.at_ms, ts) > now {
+                    if due_by(e).is_none() {
                         break;
                     }
                     match e.action {
@@ -474,7 +494,8 @@ pub fn run<L: Link>(
                     continue;
                 }
                 let only: Vec<Request> = reqs.iter().map(|(_, q)| *q).collect();
-                let (swap, refused) = r.change(first, due, &only)?;
+                let events: Vec<usize> = reqs.iter().map(|(e, _)| *e).collect();
+                let (swap, refused) = r.change(&events, due, &only)?;
                 swaps.extend(swap);
                 // A refused command is in Error; a refused override changes nothing.
                 for (q, refusal) in refused {
@@ -493,7 +514,12 @@ pub fn run<L: Link>(
                 }
                 continue;
             }
-            r.link.wait(poll.min(due - now));
+            if now >= end_by {
+                // A position never reached: the events from here are not played.
+                break;
+            }
+            let wait = (start + ticks_of(e.at_ms, ts)).saturating_sub(now);
+            r.link.wait(poll.min(wait).max(1));
             continue;
         }
         if r.settled(now) || now >= end_by {

@@ -265,6 +265,39 @@ impl Timeline {
         self.parts.last().map_or(self.origin.0, |p| p.end_tick())
     }
 
+    /// Everything played from the origin to tick `until` as one program (parts, pauses
+    /// between them, a held velocity), for traces and plots (not bounded by the program
+    /// memory).
+    pub fn played(&self, until: u64) -> Program {
+        let mut segments = Vec::new();
+        let mut tick = self.origin.0;
+        let hold = |segments: &mut Vec<Segment>, n: u64| {
+            let mut left = n;
+            while left > 0 {
+                let k = left.min(u64::from(u32::MAX));
+                segments.push(Segment {
+                    ticks: k as u32,
+                    snap: 0,
+                });
+                left -= k;
+            }
+        };
+        for p in &self.parts {
+            hold(&mut segments, p.start_tick.saturating_sub(tick));
+            segments.extend(p.program.segments.iter().copied());
+            tick = p.end_tick();
+        }
+        hold(&mut segments, until.saturating_sub(tick));
+        let mut left = until.saturating_sub(self.origin.0);
+        segments.retain_mut(|s| {
+            let n = u64::from(s.ticks).min(left);
+            left -= n;
+            s.ticks = n as u32;
+            n > 0
+        });
+        Program { segments }
+    }
+
     /// The program the fabric must play from tick `t` on: the parts' segments from `t`, and,
     /// when the last part holds a velocity, cruise segments (snap 0) while the position
     /// register holds; the first `max_segments` of them (the rest goes up in a later swap).

@@ -1,0 +1,483 @@
+//! `snapgen online`: plays a timed script of PLCopen commands (MC_MoveAbsolute with its buffer
+//! modes, MC_MoveVelocity, MC_Halt, the feed override) on a board through the host axis
+//! (`snapgen_model::axis`): the device model or the Verilated I/O top (with the device model in
+//! lockstep) at the design's clock and baud rate, or a real board on a serial port.
+//!
+//! The script is TOML (docs/ONLINE.md):
+//!
+//! ```toml
+//! order = 3                  # 3 (jerk-limited) or 2 (trapezoid)
+//! stop_deceleration = 3000   # the board's controlled stop (unit/s², unit/s³)
+//! stop_jerk = 50000
+//! [[event]]
+//! at_ms = 0
+//! kind = "move_absolute"
+//! position = 400.0
+//! velocity = 100.0
+//! acceleration = 4000.0
+//! deceleration = 3000.0
+//! jerk = 50000.0
+//! buffer_mode = "aborting"   # buffered, blending_low, blending_previous, blending_next, blending_high
+//! [[event]]
+//! at_ms = 500
+//! override = 0.5             # the feed override, 0–2
+//! ```
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, ensure, Context};
+use serde::{Deserialize, Serialize};
+use snapgen_model::axis::driver::{
+    power_up, run, stop_limits, Action, Event, Link, LinkError, RunOptions, RunReport,
+};
+use snapgen_model::axis::{AxisSettings, Goal, MotionCommand, Outcome};
+use snapgen_model::device::Design;
+use snapgen_model::online::OnlineOrder;
+use snapgen_model::protocol::{Command, Reply};
+use snapgen_model::timing::Timing;
+use snapgen_model::{Format, Trace, DEFAULT_FORMAT};
+use snapgen_sim::board::VirtualBoard;
+use snapgen_sim::host_link::BoardLink;
+
+/// A script file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Script {
+    /// Profile order: 3 or 2.
+    #[serde(default = "three")]
+    pub order: u8,
+    /// The board's controlled stop: deceleration (unit/s²) [default: the largest of the
+    /// script].
+    #[serde(default)]
+    pub stop_deceleration: Option<f64>,
+    /// Its jerk (unit/s³) [default: the largest of the script].
+    #[serde(default)]
+    pub stop_jerk: Option<f64>,
+    /// The events, in time order.
+    #[serde(rename = "event")]
+    pub events: Vec<Event>,
+}
+
+fn three() -> u8 {
+    3
+}
+
+impl Script {
+    /// Reads and checks a script file.
+    pub fn read(path: &Path) -> anyhow::Result<Script> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read the script {}", path.display()))?;
+        let s: Script = toml::from_str(&text).with_context(|| {
+            format!("{} is not a valid script (docs/ONLINE.md)", path.display())
+        })?;
+        s.check()?;
+        Ok(s)
+    }
+
+    /// Times in order and not negative, an order of 3 or 2, at least one event.
+    pub fn check(&self) -> anyhow::Result<()> {
+        ensure!(!self.events.is_empty(), "the script has no [[event]]");
+        ensure!(
+            matches!(self.order, 2 | 3),
+            "order = {}: give 3 (jerk-limited) or 2 (trapezoid)",
+            self.order
+        );
+        let mut last = 0.0;
+        for (k, e) in self.events.iter().enumerate() {
+            ensure!(
+                e.at_ms.is_finite() && e.at_ms >= last,
+                "event {k}: at_ms = {} must be finite, ≥ 0 and not before the event before it",
+                e.at_ms
+            );
+            last = e.at_ms;
+        }
+        Ok(())
+    }
+
+    fn order(&self) -> OnlineOrder {
+        if self.order == 2 {
+            OnlineOrder::Two
+        } else {
+            OnlineOrder::Three
+        }
+    }
+
+    /// The stop limits: as given, or the largest deceleration and jerk of the script.
+    fn stop(&self) -> (f64, f64) {
+        let (mut d, mut j) = (0.0f64, 0.0f64);
+        for e in &self.events {
+            if let Action::Command(c) = e.action {
+                let (dc, jc) = match c {
+                    MotionCommand::MoveAbsolute {
+                        deceleration, jerk, ..
+                    }
+                    | MotionCommand::MoveVelocity {
+                        deceleration, jerk, ..
+                    }
+                    | MotionCommand::Halt { deceleration, jerk } => (deceleration, jerk),
+                };
+                d = d.max(dc);
+                j = j.max(jc);
+            }
+        }
+        (
+            self.stop_deceleration.unwrap_or(d).max(f64::MIN_POSITIVE),
+            self.stop_jerk.unwrap_or(j).max(f64::MIN_POSITIVE),
+        )
+    }
+}
+
+/// Which board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BoardKind {
+    /// The device model.
+    Model,
+    /// The Verilated I/O top, the device model in lockstep (every output compared).
+    Fabric,
+}
+
+/// A real board on a serial port: the host's clock is the wall clock.
+struct SerialLink {
+    link: crate::send::Link,
+    t0: Instant,
+    ts: f64,
+    baud: u32,
+}
+
+impl Link for SerialLink {
+    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
+        self.link
+            .transact(*c, false)
+            .map_err(|e| LinkError(e.to_string()))
+    }
+
+    fn wait(&mut self, ticks: u64) {
+        std::thread::sleep(Duration::from_secs_f64(ticks as f64 * self.ts));
+    }
+
+    fn host_ticks(&self) -> f64 {
+        self.t0.elapsed().as_secs_f64() / self.ts
+    }
+
+    fn byte_ticks(&self) -> f64 {
+        10.0 / f64::from(self.baud) / self.ts
+    }
+}
+
+/// Where to run.
+pub struct Target {
+    /// A virtual board, or None with `port`.
+    pub board: BoardKind,
+    /// A serial port.
+    pub port: Option<String>,
+    /// Baud rate (the virtual board's design, or the port's).
+    pub baud: u32,
+}
+
+/// The result of a run, with what the board was.
+pub struct Played {
+    /// The run.
+    pub report: RunReport,
+    /// The script.
+    pub script: Script,
+    /// Fabric against model: clocks that differed (None: no fabric in the run).
+    pub mismatches: Option<u64>,
+    /// The first of them, described.
+    pub first_mismatch: Option<String>,
+    /// Board clocks simulated (virtual boards).
+    pub clocks: Option<u64>,
+}
+
+/// The board's format, read from its identity (PING): what the host plans with.
+fn board_format<L: Link>(link: &mut L) -> anyhow::Result<Format> {
+    match link
+        .ask(&Command::Ping)
+        .map_err(|e| anyhow::anyhow!("{e}"))?
+    {
+        Reply::Identity(id) => Ok(crate::send::board_format(&id, DEFAULT_FORMAT.position_lsb)?),
+        r => bail!("the board answered PING with {r:?}"),
+    }
+}
+
+fn play_on<L: Link>(link: &mut L, script: &Script) -> anyhow::Result<RunReport> {
+    let format = board_format(link)?;
+    let (d, j) = script.stop();
+    power_up(link, stop_limits(d, j, &format))?;
+    let settings = AxisSettings {
+        format,
+        order: script.order(),
+    };
+    Ok(run(link, settings, &script.events, &RunOptions::default())?)
+}
+
+/// Plays `script` on `target`.
+pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
+    if let Some(port) = &target.port {
+        let link = crate::send::Link::open(port, target.baud, Duration::from_millis(300), 3)?;
+        let mut l = SerialLink {
+            link,
+            t0: Instant::now(),
+            ts: DEFAULT_FORMAT.ts,
+            baud: target.baud,
+        };
+        let f = board_format(&mut l)?;
+        l.ts = f.ts;
+        let report = play_on(&mut l, &script)?;
+        return Ok(Played {
+            report,
+            script,
+            mismatches: None,
+            first_mismatch: None,
+            clocks: None,
+        });
+    }
+    let design = design(target.baud)?;
+    let board = match target.board {
+        BoardKind::Model => VirtualBoard::model(&design),
+        BoardKind::Fabric => VirtualBoard::lockstep(&design)?,
+    };
+    let mut link = BoardLink::new(board);
+    let report = play_on(&mut link, &script)?;
+    let b = link.board();
+    let fabric = target.board == BoardKind::Fabric;
+    Ok(Played {
+        report,
+        script,
+        mismatches: fabric.then(|| b.mismatches()),
+        first_mismatch: b.first_mismatch().map(|m| format!("{m:?}")),
+        clocks: Some(b.clocks()),
+    })
+}
+
+/// The virtual board's design: the default clock and Ts, at `baud`.
+pub fn design(baud: u32) -> anyhow::Result<Design> {
+    let t = Timing {
+        baud,
+        ..Timing::default()
+    };
+    let d = Design::from_timing(&DEFAULT_FORMAT, &t)
+        .with_context(|| format!("a board at {baud} baud"))?;
+    Ok(snapgen_hdl::verilog::io_design(&d))
+}
+
+/// One command's line in the JSON.
+#[derive(Serialize)]
+struct CommandJson {
+    event: usize,
+    at_ms: f64,
+    command: &'static str,
+    outcome: &'static str,
+    error_id: Option<String>,
+    note: Option<String>,
+    /// Ticks from the event to the first tick that obeyed it (its swap), when it had one.
+    latency_ms: Option<f64>,
+}
+
+/// The registers, as decimal strings (they exceed 64 bits).
+#[derive(Serialize)]
+struct Raw {
+    x: String,
+    v: String,
+    a: String,
+    j: String,
+}
+
+/// `--json`'s object.
+#[derive(Serialize)]
+struct Json {
+    commands: Vec<CommandJson>,
+    refused_overrides: Vec<(usize, String)>,
+    replans: usize,
+    extension_swaps: u32,
+    ticks: u64,
+    ts: f64,
+    final_lsb: i128,
+    target_lsb: Option<i128>,
+    final_raw: Raw,
+    state_checks: u64,
+    mismatches: Option<u64>,
+    clocks: Option<u64>,
+}
+
+/// The position a command ends on (output LSBs), if it does.
+fn target_lsb(p: &Played) -> Option<i128> {
+    let axis = &p.report.axis;
+    let last = axis
+        .commands
+        .iter()
+        .rposition(|c| !matches!(c.outcome, Outcome::Error(_)))?;
+    axis.timeline
+        .parts
+        .iter()
+        .rev()
+        .find(|q| q.command == last && !q.cut)
+        .and_then(|q| match q.goal {
+            Goal::Position { cell, velocity } if velocity == 0.0 => Some(cell),
+            _ => None,
+        })
+}
+
+fn command_lines(p: &Played) -> Vec<CommandJson> {
+    let r = &p.report;
+    let ts = r.axis.settings.format.ts;
+    let mut out = Vec::new();
+    for (k, e) in p.script.events.iter().enumerate() {
+        let Some(Some(c)) = r.event_commands.get(k) else {
+            continue;
+        };
+        let rec = &r.axis.commands[*c];
+        let start = r.start_tick;
+        let due = start + (e.at_ms * 1e-3 / ts).round() as u64;
+        let latency = r
+            .swaps
+            .iter()
+            .find(|s| s.events.contains(&k))
+            .map(|s| s.tick.saturating_sub(due) as f64 * ts * 1e3);
+        out.push(CommandJson {
+            event: k,
+            at_ms: e.at_ms,
+            command: rec.command.name(),
+            outcome: rec.outcome.name(),
+            error_id: match &rec.outcome {
+                Outcome::Error(id) => Some(id.to_string()),
+                _ => None,
+            },
+            note: rec.note.clone(),
+            latency_ms: latency,
+        });
+    }
+    out
+}
+
+/// The `--json` object.
+pub fn json(p: &Played) -> String {
+    let r = &p.report;
+    let f = r.axis.settings.format;
+    let j = Json {
+        commands: command_lines(p),
+        refused_overrides: r
+            .refused_overrides
+            .iter()
+            .map(|(e, id)| (*e, id.to_string()))
+            .collect(),
+        replans: r.swaps.len(),
+        extension_swaps: r.extensions,
+        ticks: r.last.ticks - r.start_tick,
+        ts: f.ts,
+        final_lsb: f.output_lsb(r.last.x),
+        target_lsb: target_lsb(p),
+        final_raw: Raw {
+            x: r.last.x.to_string(),
+            v: r.last.v.to_string(),
+            a: r.last.a.to_string(),
+            j: r.last.j.to_string(),
+        },
+        state_checks: r.checks,
+        mismatches: p.mismatches,
+        clocks: p.clocks,
+    };
+    serde_json::to_string_pretty(&j).expect("plain data serialises")
+}
+
+/// The human summary.
+pub fn describe(p: &Played) -> String {
+    let r = &p.report;
+    let f = r.axis.settings.format;
+    let mut s = String::new();
+    for c in command_lines(p) {
+        s += &format!(
+            "  event {:>2} at {:>8.1} ms  {:<16} {:<15}{}{}{}\n",
+            c.event,
+            c.at_ms,
+            c.command,
+            c.outcome,
+            c.latency_ms
+                .map_or(String::new(), |l| format!(" latency {l:.2} ms")),
+            c.error_id
+                .map_or(String::new(), |e| format!(" ErrorID: {e}")),
+            c.note.map_or(String::new(), |n| format!(" ({n})")),
+        );
+    }
+    for (e, id) in &r.refused_overrides {
+        s += &format!("  event {e:>2}: override refused: {id}\n");
+    }
+    s += &format!(
+        "  {} replans ({} more swaps to upload long programs), {} ticks ({:.3} s), {} board states checked bit for bit against the plan\n",
+        r.swaps.len(),
+        r.extensions,
+        r.last.ticks - r.start_tick,
+        (r.last.ticks - r.start_tick) as f64 * f.ts,
+        r.checks
+    );
+    s += &format!(
+        "  final position {} LSB{}, registers x={} v={} a={} j={}",
+        f.output_lsb(r.last.x),
+        target_lsb(p).map_or(String::new(), |t| format!(" (target {t})")),
+        r.last.x,
+        r.last.v,
+        r.last.a,
+        r.last.j
+    );
+    if let Some(m) = p.mismatches {
+        s += &format!("\n  fabric against model: {m} mismatches");
+        if let Some(first) = &p.first_mismatch {
+            s += &format!(" (first: {first})");
+        }
+    }
+    s
+}
+
+/// Writes the per-tick integer trace: tick, x, v, a, j (raw), output LSB.
+pub fn write_csv(p: &Played, path: &PathBuf) -> anyhow::Result<()> {
+    let r = &p.report;
+    let f = r.axis.settings.format;
+    let t = &r.axis.timeline;
+    let program = t.played(r.last.ticks);
+    let mut w = std::io::BufWriter::new(
+        std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?,
+    );
+    writeln!(w, "tick,x,v,a,j,position_lsb")?;
+    let (t0, s0) = t.origin;
+    writeln!(
+        w,
+        "{t0},{},{},{},{},{}",
+        s0.x,
+        s0.v,
+        s0.a,
+        s0.j,
+        f.output_lsb(s0.x)
+    )?;
+    for k in Trace::new(&program, s0, f.widths) {
+        let s = k.state;
+        writeln!(
+            w,
+            "{},{},{},{},{},{}",
+            t0 + k.tick + 1,
+            s.x,
+            s.v,
+            s.a,
+            s.j,
+            f.output_lsb(s.x)
+        )?;
+    }
+    Ok(())
+}
+
+/// Plots position, velocity, acceleration and jerk with the events marked.
+pub fn write_svg(p: &Played, title: &str, path: &Path) -> anyhow::Result<()> {
+    let r = &p.report;
+    let f = r.axis.settings.format;
+    let t = &r.axis.timeline;
+    let program = t.played(r.last.ticks);
+    let offset = (r.start_tick - t.origin.0) as f64 * f.ts;
+    let events: Vec<f64> = p
+        .script
+        .events
+        .iter()
+        .map(|e| offset + e.at_ms * 1e-3)
+        .collect();
+    crate::plot::write_program_svg(&program, t.origin.1, &f, title, &events, path)
+        .map_err(|e| anyhow::anyhow!("cannot draw {}: {e}", path.display()))
+}

@@ -1,0 +1,126 @@
+//! Built-in scripts for `snapgen online --scenario` (units: mm and s; docs/ONLINE.md).
+//!
+//! * `seed002`: seed 002's demonstration (Red 2000, Figures 5–7): a 400 mm move whose set speed
+//!   is changed several times, a 100 mm tangent move entering the buffer at 300 mm,
+//!   acceleration 4000 mm/s², deceleration 3000 mm/s², jerk 5000, 50 000 or 500 000 mm/s³
+//!   (`--jerk`, default 50 000). The paper gives the lengths and limits but not the set speeds
+//!   or when they change (they are only drawn): this script's set speeds are ours — 100 mm/s,
+//!   then 200, 50 and 150 mm/s — given as feed overrides of a 200 mm/s move, and the tangent
+//!   move blends in at the previous move's set speed (BlendingPrevious).
+//! * `seed000-fig3`: the two MC_MoveAbsolute cases of seed 000's Figure 3 (the standard's
+//!   timing diagram): (a) the second block starts after the first has stopped, (b) it starts
+//!   while the first still moves (Aborting); both end on the same position. The figure has no
+//!   numbers; ours are the standard's example scaled down (positions 6 and 10 mm, velocities
+//!   150 and 100 mm/s), case (a) followed by a return to 0 and case (b).
+
+use snapgen_model::axis::driver::{Action, Event};
+use snapgen_model::axis::{BufferMode, MotionCommand};
+
+use crate::online::Script;
+
+/// A built-in scenario.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Scenario {
+    /// Seed 002's Figures 5–7.
+    Seed002,
+    /// Seed 000's Figure 3.
+    #[value(name = "seed000-fig3")]
+    Seed000Fig3,
+}
+
+fn at(ms: f64, c: MotionCommand) -> Event {
+    Event {
+        at_ms: ms,
+        at_position: None,
+        action: Action::Command(c),
+    }
+}
+
+fn feed(ms: f64, k: f64) -> Event {
+    Event {
+        at_ms: ms,
+        at_position: None,
+        action: Action::Override { r#override: k },
+    }
+}
+
+fn mv(position: f64, velocity: f64, jerk: f64, buffer_mode: BufferMode) -> MotionCommand {
+    MotionCommand::MoveAbsolute {
+        position,
+        velocity,
+        acceleration: 4000.0,
+        deceleration: 3000.0,
+        jerk,
+        buffer_mode,
+    }
+}
+
+impl Scenario {
+    /// Its script.
+    pub fn script(self, jerk: Option<f64>) -> anyhow::Result<Script> {
+        let s = match self {
+            Scenario::Seed002 => {
+                let j = jerk.unwrap_or(50_000.0);
+                anyhow::ensure!(
+                    j.is_finite() && j > 0.0,
+                    "--jerk {j}: give a jerk > 0 (the seed uses 5000, 50000 and 500000 mm/s³)"
+                );
+                Script {
+                    order: 3,
+                    stop_deceleration: None,
+                    stop_jerk: None,
+                    events: vec![
+                        feed(0.0, 0.5),
+                        at(0.0, mv(400.0, 200.0, j, BufferMode::Aborting)),
+                        feed(800.0, 1.0),
+                        feed(1300.0, 0.25),
+                        Event {
+                            at_ms: 1300.0,
+                            at_position: Some(300.0),
+                            action: Action::Command(mv(
+                                500.0,
+                                200.0,
+                                j,
+                                BufferMode::BlendingPrevious,
+                            )),
+                        },
+                        feed(2200.0, 0.75),
+                    ],
+                }
+            }
+            Scenario::Seed000Fig3 => {
+                let j = jerk.unwrap_or(500_000.0);
+                Script {
+                    order: 3,
+                    stop_deceleration: None,
+                    stop_jerk: None,
+                    events: vec![
+                        // (a) the second block after the first has stopped.
+                        at(0.0, mv(6.0, 150.0, j, BufferMode::Aborting)),
+                        at(150.0, mv(10.0, 100.0, j, BufferMode::Aborting)),
+                        // Back to the start.
+                        at(300.0, mv(0.0, 150.0, j, BufferMode::Aborting)),
+                        // (b) the second block while the first still moves.
+                        at(450.0, mv(6.0, 150.0, j, BufferMode::Aborting)),
+                        at(480.0, mv(10.0, 100.0, j, BufferMode::Aborting)),
+                    ],
+                }
+            }
+        };
+        s.check()?;
+        Ok(s)
+    }
+
+    /// A title for the summary and the plot.
+    pub fn title(self, jerk: Option<f64>) -> String {
+        match self {
+            Scenario::Seed002 => format!(
+                "seed 002 (Figures 5–7): 400 mm, set speed changes, a 100 mm tangent move at 300 mm, jerk {} mm/s³",
+                jerk.unwrap_or(50_000.0)
+            ),
+            Scenario::Seed000Fig3 => {
+                "seed 000 Figure 3: MC_MoveAbsolute after a stop (a) and while moving (b)".into()
+            }
+        }
+    }
+}
