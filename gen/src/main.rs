@@ -536,6 +536,8 @@ enum InputError {
     Board(String),
     #[error(transparent)]
     Send(send::InputError),
+    #[error("{0:#}")]
+    Script(anyhow::Error),
 }
 
 /// The co-simulation found a difference (exit 1; the report is already printed).
@@ -705,9 +707,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let (script, title) = match (script, scenario) {
                 (Some(path), _) => {
                     let title = format!("snapgen online {}", path.display());
-                    (online::Script::read(&path)?, title)
+                    (
+                        online::Script::read(&path).map_err(InputError::Script)?,
+                        title,
+                    )
                 }
-                (None, Some(s)) => (s.script(jerk)?, s.title(jerk)),
+                (None, Some(s)) => (s.script(jerk).map_err(InputError::Script)?, s.title(jerk)),
                 (None, None) => anyhow::bail!("give --script FILE or --scenario NAME"),
             };
             let target = online::Target { board, port, baud };

@@ -314,7 +314,10 @@ fn target_lsb(p: &Played) -> Option<i128> {
         .rev()
         .find(|q| q.command == last && !q.cut)
         .and_then(|q| match q.goal {
-            Goal::Position { cell, velocity } if velocity == 0.0 => Some(cell),
+            Goal::Position {
+                cell,
+                velocity: 0.0,
+            } => Some(cell),
             _ => None,
         })
 }
@@ -324,12 +327,25 @@ fn command_lines(p: &Played) -> Vec<CommandJson> {
     let ts = r.axis.settings.format.ts;
     let mut out = Vec::new();
     for (k, e) in p.script.events.iter().enumerate() {
-        let Some(Some(c)) = r.event_commands.get(k) else {
+        let Some(taken) = r.event_commands.get(k) else {
+            if let Action::Command(c) = e.action {
+                out.push(CommandJson {
+                    event: k,
+                    at_ms: e.at_ms,
+                    command: c.name(),
+                    outcome: "NotGiven",
+                    error_id: None,
+                    note: Some("its position was not reached before the run ended".into()),
+                    latency_ms: None,
+                });
+            }
+            continue;
+        };
+        let Some(c) = taken else {
             continue;
         };
         let rec = &r.axis.commands[*c];
-        let start = r.start_tick;
-        let due = start + (e.at_ms * 1e-3 / ts).round() as u64;
+        let due = r.event_ticks[k];
         let latency = r
             .swaps
             .iter()
@@ -440,21 +456,12 @@ pub fn write_csv(p: &Played, path: &PathBuf) -> anyhow::Result<()> {
     );
     writeln!(w, "tick,x,v,a,j,position_lsb")?;
     let (t0, s0) = t.origin;
-    writeln!(
-        w,
-        "{t0},{},{},{},{},{}",
-        s0.x,
-        s0.v,
-        s0.a,
-        s0.j,
-        f.output_lsb(s0.x)
-    )?;
     for k in Trace::new(&program, s0, f.widths) {
         let s = k.state;
         writeln!(
             w,
             "{},{},{},{},{},{}",
-            t0 + k.tick + 1,
+            t0 + k.tick,
             s.x,
             s.v,
             s.a,

@@ -507,3 +507,99 @@ fn gains_prints_configure_values_and_refuses_bad_designs() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("broken-motor.toml"));
 }
+
+const SCRIPT: &str = r#"
+order = 3
+[[event]]
+at_ms = 0
+kind = "move_absolute"
+position = 3.0
+velocity = 100.0
+acceleration = 4000.0
+deceleration = 3000.0
+jerk = 500000.0
+[[event]]
+at_ms = 0
+kind = "move_absolute"
+position = 5.0
+velocity = 60.0
+acceleration = 4000.0
+deceleration = 3000.0
+jerk = 500000.0
+buffer_mode = "blending_low"
+[[event]]
+at_ms = 20
+override = 0.5
+"#;
+
+#[test]
+fn online_plays_a_script_and_reports_every_field() {
+    let script = tmp("script.toml");
+    std::fs::write(&script, SCRIPT).unwrap();
+    let (csv, svg) = (tmp("online.csv"), tmp("online.svg"));
+    let out = snapgen(&[
+        "online",
+        "--script",
+        script.to_str().unwrap(),
+        "--baud",
+        "3000000",
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let outcomes: Vec<&str> = j["commands"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["outcome"].as_str().unwrap())
+        .collect();
+    assert_eq!(outcomes, ["Done", "Done"]);
+    assert!(j["replans"].as_u64().unwrap() >= 1);
+    assert_eq!(j["final_lsb"], j["target_lsb"]);
+    assert_eq!(j["target_lsb"].as_i64(), Some(5_000_000));
+    assert_eq!(j["final_raw"]["v"], "0");
+    assert!(j["mismatches"].is_null(), "the model board has no fabric");
+    // One row per tick from the script's first state to the last one read, and the last row
+    // is the final register.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<&str> = text.lines().collect();
+    assert_eq!(rows[0], "tick,x,v,a,j,position_lsb");
+    let first: Vec<&str> = rows[1].split(',').collect();
+    let last: Vec<&str> = rows.last().unwrap().split(',').collect();
+    let span = last[0].parse::<u64>().unwrap() - first[0].parse::<u64>().unwrap();
+    assert_eq!(
+        Some(span),
+        j["ticks"].as_u64(),
+        "{} .. {}",
+        rows[1],
+        rows.last().unwrap()
+    );
+    assert_eq!(rows.len() as u64, span + 2);
+    assert_eq!(last[1], j["final_raw"]["x"].as_str().unwrap());
+    assert!(std::fs::metadata(&svg).unwrap().len() > 1000);
+}
+
+#[test]
+fn online_refuses_a_bad_script_with_exit_2() {
+    let script = tmp("bad.toml");
+    std::fs::write(
+        &script,
+        "[[event]]\nat_ms = 5\nkind = \"move_absolute\"\nposition = 1.0\n",
+    )
+    .unwrap();
+    let out = snapgen(&["online", "--script", script.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a valid script"));
+    std::fs::write(&script, "order = 5\n[[event]]\nat_ms = 0\noverride = 1.0\n").unwrap();
+    let out = snapgen(&["online", "--script", script.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("order = 5"));
+}

@@ -102,6 +102,9 @@ pub struct RunReport {
     pub axis: HostAxis,
     /// Which command each event gave (None: an override).
     pub event_commands: Vec<Option<usize>>,
+    /// The tick each event was taken on (its time, or when its position was seen reached);
+    /// events never taken (a position not reached) are missing at the end.
+    pub event_ticks: Vec<u64>,
     /// Override events refused (event index, why).
     pub refused_overrides: Vec<(usize, AxisErrorId)>,
     /// Program swaps.
@@ -443,6 +446,7 @@ pub fn run<L: Link>(
     let mut swaps = Vec::new();
     let mut event_commands = Vec::new();
     let mut refused_overrides = Vec::new();
+    let mut event_ticks = Vec::new();
     let mut next = 0;
     let last_due = script
         .last()
@@ -475,6 +479,11 @@ pub fn run<L: Link>(
                     if due_by(e).is_none() {
                         break;
                     }
+                    event_ticks.push(if e.at_position.is_some() {
+                        now
+                    } else {
+                        start + ticks_of(e.at_ms, ts)
+                    });
                     match e.action {
                         Action::Command(c) => {
                             let k = r.axis.submit(c);
@@ -534,6 +543,7 @@ pub fn run<L: Link>(
         last: r.last,
         axis: r.axis,
         event_commands,
+        event_ticks,
         refused_overrides,
         swaps,
         start_tick: start,
