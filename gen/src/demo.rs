@@ -197,6 +197,39 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         "the core synthesised with latches"
     );
 
+    // Online replanning through the PLCopen host axis: seed 000's Figure 3 on the Verilated I/O
+    // top (the device model in lockstep, every output compared), at 125 MHz and 115 200 baud.
+    println!("\n== online: seed 000 Figure 3 through the PLCopen host axis on the fabric (`snapgen online --scenario seed000-fig3 --board fabric`)");
+    let sc = crate::scenario::Scenario::Seed000Fig3;
+    let played = crate::online::play(
+        sc.script(None)?,
+        &crate::online::Target {
+            board: crate::online::BoardKind::Fabric,
+            port: None,
+            baud: snapgen_model::timing::DEFAULT_BAUD,
+        },
+    )?;
+    println!("{}", crate::online::describe(&played));
+    crate::online::write_svg(
+        &played,
+        &sc.title(None),
+        &out.join("seed000_fig3_online.svg"),
+    )?;
+    ensure!(
+        played.mismatches == Some(0),
+        "the fabric and the model disagreed during the online scenario"
+    );
+    let r = &played.report;
+    let f0 = r.axis.settings.format;
+    ensure!(
+        r.axis.commands.iter().all(|c| matches!(
+            c.outcome,
+            snapgen_model::axis::Outcome::Done | snapgen_model::axis::Outcome::CommandAborted
+        )) && f0.output_lsb(r.last.x) == crate::scenario::cell_mm(10.0, &f0)
+            && (r.last.v, r.last.a, r.last.j) == (0, 0, 0),
+        "the online scenario did not end at rest on 10 mm with every command done or aborted"
+    );
+
     // Seed 001's experiment, short form, on the closed loop: the Verilated I/O top drives a
     // simulated maxon RE 40 with the paper's load; the device model compares every clock.
     println!("\n== closed loop: seed 001's experiment (short form: `snapgen experiment seed001` runs it whole)");

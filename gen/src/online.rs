@@ -488,3 +488,30 @@ pub fn write_svg(p: &Played, title: &str, path: &Path) -> anyhow::Result<()> {
     crate::plot::write_program_svg(&program, t.origin.1, &f, title, &events, path)
         .map_err(|e| anyhow::anyhow!("cannot draw {}: {e}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The script format's example in docs/ONLINE.md parses, passes the checks, and holds
+    /// every kind of event.
+    #[test]
+    fn the_documented_script_is_valid() {
+        let doc = include_str!("../../docs/ONLINE.md");
+        let start = doc.find("```toml\n").expect("a TOML block") + 8;
+        let len = doc[start..].find("```").unwrap();
+        let s: Script = toml::from_str(&doc[start..start + len]).unwrap();
+        s.check().unwrap();
+        assert_eq!(s.events.len(), 4);
+        assert!(matches!(
+            s.events[0].action,
+            Action::Command(MotionCommand::MoveAbsolute { .. })
+        ));
+        assert!(matches!(s.events[1].action, Action::Override { .. }));
+        assert_eq!(s.events[2].at_position, Some(300.0));
+        assert!(matches!(
+            s.events[3].action,
+            Action::Command(MotionCommand::Halt { .. })
+        ));
+    }
+}
