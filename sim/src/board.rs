@@ -13,7 +13,8 @@ use snapgen_plant::{BridgePins, Physical, Plant};
 
 use crate::build::build_io;
 use crate::io::{
-    decode_outputs, encode_inputs, encode_outputs, FabricIo, IoSignal, IN_WORDS, OUT_WORDS,
+    decode_outputs, encode_inputs, encode_outputs, first_difference, FabricIo, IoSignal, IN_WORDS,
+    OUT_WORDS,
 };
 use crate::SimError;
 
@@ -220,17 +221,15 @@ impl VirtualBoard {
                                 }
                             }
                             let want = encode_outputs(&dev.clock(i));
-                            if words != want.as_slice() {
+                            if let Some((signal, expected, actual)) = first_difference(words, &want)
+                            {
                                 self.mismatches += 1;
                                 if self.first_mismatch.is_none() {
-                                    let signal = IoSignal::all()
-                                        .find(|s| s.value(words) != s.value(&want))
-                                        .expect("every output bit belongs to a signal (tested)");
                                     self.first_mismatch = Some(BoardMismatch {
                                         clock,
                                         signal,
-                                        expected: signal.value(&want),
-                                        actual: signal.value(words),
+                                        expected,
+                                        actual,
                                     });
                                 }
                             }

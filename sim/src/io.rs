@@ -210,6 +210,18 @@ pub fn encode_inputs(i: &IoInputs) -> [u32; IN_WORDS] {
     w
 }
 
+/// The first signal whose value differs between the fabric's outputs `got` and the model's
+/// `want`: (signal, model's value, fabric's value). Every output bit belongs to a signal
+/// (tested), so equal signals mean equal vectors.
+pub fn first_difference(got: &[u32], want: &[u32]) -> Option<(IoSignal, u128, u128)> {
+    if got == want {
+        return None;
+    }
+    IoSignal::all()
+        .find(|s| s.value(got) != s.value(want))
+        .map(|s| (s, s.value(want), s.value(got)))
+}
+
 /// A clock's outputs in the harness's layout.
 pub fn encode_outputs(o: &IoOutputs) -> [u32; OUT_WORDS] {
     let mut w = [0u32; OUT_WORDS];

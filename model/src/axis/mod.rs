@@ -271,17 +271,6 @@ impl Timeline {
     pub fn played(&self, until: u64) -> Program {
         let mut segments = Vec::new();
         let mut tick = self.origin.0;
-        let hold = |segments: &mut Vec<Segment>, n: u64| {
-            let mut left = n;
-            while left > 0 {
-                let k = left.min(u64::from(u32::MAX));
-                segments.push(Segment {
-                    ticks: k as u32,
-                    snap: 0,
-                });
-                left -= k;
-            }
-        };
         for p in &self.parts {
             hold(&mut segments, p.start_tick.saturating_sub(tick));
             segments.extend(p.program.segments.iter().copied());
@@ -307,16 +296,7 @@ impl Timeline {
         for p in &self.parts {
             if p.start_tick > tick && p.start_tick > t {
                 // A pause between parts: snap 0 until the next begins.
-                let n = p.start_tick - tick.max(t);
-                let mut left = n;
-                while left > 0 {
-                    let k = left.min(u64::from(u32::MAX));
-                    segments.push(Segment {
-                        ticks: k as u32,
-                        snap: 0,
-                    });
-                    left -= k;
-                }
+                hold(&mut segments, p.start_tick - tick.max(t));
             }
             tick = p.end_tick();
             let mut skip = t.saturating_sub(p.start_tick);
@@ -336,19 +316,26 @@ impl Timeline {
         if let Some(p) = self.parts.last() {
             if p.end.v != 0 {
                 let room = cruise_room(&p.end, format);
-                let mut left = room.saturating_sub(t.saturating_sub(p.end_tick()));
-                while left > 0 && segments.len() < format.max_segments {
-                    let n = left.min(u64::from(u32::MAX));
-                    segments.push(Segment {
-                        ticks: n as u32,
-                        snap: 0,
-                    });
-                    left -= n;
-                }
+                let left = room.saturating_sub(t.saturating_sub(p.end_tick()));
+                let most = u64::from(u32::MAX) * format.max_segments as u64;
+                hold(&mut segments, left.min(most));
             }
         }
         segments.truncate(format.max_segments);
         Program { segments }
+    }
+}
+
+/// Appends `n` ticks of snap 0 (segments of at most 2³² − 1 ticks).
+fn hold(segments: &mut Vec<Segment>, n: u64) {
+    let mut left = n;
+    while left > 0 {
+        let k = left.min(u64::from(u32::MAX));
+        segments.push(Segment {
+            ticks: k as u32,
+            snap: 0,
+        });
+        left -= k;
     }
 }
 
