@@ -148,9 +148,15 @@ struct SerialLink {
 
 impl Link for SerialLink {
     fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
-        self.link
-            .transact(*c, false)
-            .map_err(|e| LinkError(e.to_string()))
+        // A refusal is the board's answer, for the driver to act on (a LATE swap is planned
+        // again); only a failed link is an error here.
+        match self.link.transact(*c, false) {
+            Err(crate::send::SendError::Nak { reason, .. }) => Ok(Reply::Nak {
+                cmd: c.code(),
+                reason,
+            }),
+            r => r.map_err(|e| LinkError(e.to_string())),
+        }
     }
 
     fn wait(&mut self, ticks: u64) {

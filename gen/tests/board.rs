@@ -534,3 +534,50 @@ fn a_move_on_a_simulated_motor_reports_its_following_error() {
         "{c:?}"
     );
 }
+
+/// `snapgen online --port`: the host axis over a real serial link (the pseudo-terminal of the
+/// virtual board, in real time), a move and a blending move then an override cut: every state
+/// it read matched the plan, and it ends on the target.
+#[test]
+fn snapgen_online_plays_a_script_over_the_port() {
+    let board = Board::start_on(false);
+    let dir = std::env::temp_dir().join(format!("snapgen-online-port-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("script.toml");
+    let mv = |at: f64, p: f64, v: f64, mode: &str| {
+        format!(
+            "[[event]]\nat_ms = {at}\nkind = \"move_absolute\"\nposition = {p}\nvelocity = {v}\nacceleration = 4.0\ndeceleration = 3.0\njerk = 50.0\nbuffer_mode = \"{mode}\"\n"
+        )
+    };
+    let text = format!(
+        "{}{}[[event]]\nat_ms = 300\noverride = 0.5\n",
+        mv(0.0, 0.4, 0.5, "aborting"),
+        mv(0.0, 0.6, 0.3, "blending_low")
+    );
+    std::fs::write(&script, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_snapgen"))
+        .args([
+            "online",
+            "--script",
+            script.to_str().unwrap(),
+            "--port",
+            &board.port,
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    let text = ok(&out);
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let outcomes: Vec<&str> = j["commands"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["outcome"].as_str().unwrap())
+        .collect();
+    assert_eq!(outcomes, ["Done", "Done"], "{text}");
+    assert_eq!(j["target_lsb"].as_i64(), Some(600_000), "{text}");
+    assert_eq!(j["final_lsb"], j["target_lsb"], "{text}");
+    assert_eq!(j["final_raw"]["v"], "0");
+    assert!(j["state_checks"].as_u64().unwrap() > 10, "{text}");
+    assert!(j["replans"].as_u64().unwrap() >= 1, "{text}");
+}
