@@ -109,6 +109,9 @@ pub struct DPiece {
     pub free: Option<usize>,
     /// Which acceleration cap applies (index into [`Caps::a`]).
     pub cap: usize,
+    /// A piece at zero level (a hold or the cruise) whose ticks may be lent to a neighbouring
+    /// free piece that needs more time (`fit` in the planner).
+    pub slack: bool,
 }
 
 /// An end condition: a register at the end of a piece.
@@ -142,6 +145,20 @@ pub struct Problem {
     pub x_centre: f64,
     /// Initial guess of the free levels (from the continuous profile).
     pub guess: [f64; MAX_FREE],
+    /// Index of the cruise piece (position targets).
+    pub cruise: Option<usize>,
+}
+
+/// The real solution of the level equations (step 2), before rounding: what the planner
+/// checks against the limits before it asks for integers.
+#[derive(Clone, Copy, Debug)]
+pub struct Linear {
+    /// The end conditions' matrix (rows: conditions, columns: free levels).
+    m: [[f64; MAX_FREE]; MAX_FREE],
+    /// The real levels.
+    pub levels: [f64; MAX_FREE],
+    /// The velocity of the cruise piece at these levels (raw per tick), if there is one.
+    pub cruise_v: Option<f64>,
 }
 
 /// Exact caps on the registers (raw magnitudes).
@@ -149,10 +166,44 @@ pub struct Problem {
 pub struct Caps {
     /// Velocity.
     pub v: i128,
-    /// Acceleration, per cap index.
+    /// Acceleration while |v| grows (PLCopen's Acceleration).
+    pub acc: i128,
+    /// Acceleration while |v| shrinks (PLCopen's Deceleration).
+    pub dec: i128,
+    /// A start beyond its limits (lowered mid-move): the |a| its first transition may keep
+    /// while it brings it back; 0 for a start within them.
+    pub entry: i128,
+    /// The acceleration limit each transition was planned with, per cap index (what the
+    /// planner fits a level to; the checks use `acc` and `dec`).
     pub a: [i128; 3],
     /// Jerk (order 3; `i128::MAX` for order 2).
     pub j: i128,
+}
+
+impl Caps {
+    /// The acceleration cap of the ticks of one segment, from the velocity's and the
+    /// acceleration's ranges over them: `acc` when |v| grows on every tick, `dec` when it
+    /// shrinks without crossing zero, the smaller of the two otherwise; `entry` (cap index 0,
+    /// the first transition) raises it for a start beyond its limits.
+    pub fn a_cap(&self, v: (i128, i128), a: (i128, i128), cap: usize) -> i128 {
+        let (v_lo, v_hi) = v;
+        let (a_lo, a_hi) = a;
+        let grows = (v_lo >= 0 && a_lo >= 0) || (v_hi <= 0 && a_hi <= 0);
+        let shrinks = (v_lo > 0 && a_hi <= 0 && v_lo.saturating_add(a_lo) >= 0)
+            || (v_hi < 0 && a_lo >= 0 && v_hi.saturating_add(a_hi) <= 0);
+        let by_direction = if grows {
+            self.acc
+        } else if shrinks {
+            self.dec
+        } else {
+            self.acc.min(self.dec)
+        };
+        if cap == 0 {
+            by_direction.max(self.entry)
+        } else {
+            by_direction
+        }
+    }
 }
 
 /// Why an exact realisation failed.
@@ -326,13 +377,9 @@ fn round_levels(l: &[f64; MAX_FREE], n: usize) -> Option<[i128; MAX_FREE]> {
     Some(out)
 }
 
-/// Realises `p` from `start` exactly (module documentation) into `out`; returns the final state.
-pub fn realise(
-    p: &Problem,
-    start: &ChainState,
-    caps: &Caps,
-    out: &mut Program,
-) -> Result<ChainState, ExactFailure> {
+/// Step 2 of the module documentation: the real levels that meet the end conditions with the
+/// tick counts of `p`, from `start`.
+pub fn linearise(p: &Problem, start: &ChainState) -> Result<Linear, ExactFailure> {
     let n = p.free;
     let aim = aim(p);
     // 2. The linear map, in f64: F₀ from the start, columns from rest.
@@ -344,6 +391,7 @@ pub fn realise(
         j: Affine::constant(start.j as f64),
     };
     let mut piece_end_a = Vec::with_capacity(p.pieces.len());
+    let mut piece_end_v = Vec::with_capacity(p.pieces.len());
     // Map jerk pieces back to problem pieces: order 2 emits one or two per piece.
     let mut k = 0;
     for d in &p.pieces {
@@ -354,6 +402,7 @@ pub fn realise(
             k += 1;
         }
         piece_end_a.push(st.a);
+        piece_end_v.push(st.v);
     }
     let row = |c: &Condition| -> Affine {
         match *c {
@@ -388,6 +437,34 @@ pub fn realise(
     for q in 0..n {
         levels[q] += r[q];
     }
+    let cruise_v = p.cruise.map(|c| {
+        let v = piece_end_v[c];
+        v.c + v.k[..n]
+            .iter()
+            .zip(&levels[..n])
+            .map(|(k, l)| k * l)
+            .sum::<f64>()
+    });
+    Ok(Linear {
+        m,
+        levels,
+        cruise_v,
+    })
+}
+
+/// Steps 3 and 4 of the module documentation: realises `p` from `start` exactly into `out`
+/// from its real levels `lin` ([`linearise`]); returns the final state.
+pub fn realise(
+    p: &Problem,
+    start: &ChainState,
+    caps: &Caps,
+    lin: &Linear,
+    out: &mut Program,
+) -> Result<ChainState, ExactFailure> {
+    let n = p.free;
+    let aim = aim(p);
+    let (m, levels) = (lin.m, lin.levels);
+    let mut r = [0.0; MAX_FREE];
     // 3. Integers, played exactly; one refinement on the exact residual.
     let mut caps_of = Vec::with_capacity(24);
     let mut ends = Vec::with_capacity(p.pieces.len());
@@ -432,10 +509,12 @@ pub fn realise(
     Ok(fin)
 }
 
-/// Checks every tick of `program` from `start` against the caps (segment `i` uses
-/// `caps.a[caps_of[i]]`), exactly: the acceleration is linear within a segment of zero snap and
-/// a one-tick segment has only its end, so its extremes are at the ends; the velocity turns
-/// only where the acceleration changes sign, checked at the integer ticks around that point.
+/// Checks every tick of `program` from `start` against the caps (segment `i` has cap index
+/// `caps_of[i]`), exactly. A segment of zero snap has a constant jerk, so its acceleration is
+/// linear in the tick: split where the acceleration changes sign, each part has its
+/// acceleration's extremes at its ends and a monotone velocity, whose extremes are at its ends
+/// too, and its acceleration cap follows the direction ([`Caps::a_cap`]). A segment that
+/// applies snap on more than one tick (the planner makes none) is checked tick by tick.
 pub fn check_limits(
     program: &Program,
     start: &ChainState,
@@ -445,31 +524,63 @@ pub fn check_limits(
     let mut s = *start;
     for (seg, &cap) in program.segments.iter().zip(caps_of) {
         let n = u64::from(seg.ticks);
-        let first = s
-            .checked_advance(seg.snap, 1)
-            .ok_or(ExactFailure::Overflow)?;
-        let end = s
-            .checked_advance(seg.snap, n)
-            .ok_or(ExactFailure::Overflow)?;
-        let a_cap = caps.a[cap];
-        let over = |t: &ChainState| t.j.abs() > caps.j || t.a.abs() > a_cap || t.v.abs() > caps.v;
-        if over(&first) || over(&end) {
-            return Err(ExactFailure::Limit);
-        }
-        // Within the segment (n > 1, snap 0 after its first tick is not assumed: closed form).
-        if n > 2 && (first.a.signum() != end.a.signum()) && first.j != 0 {
-            // a(k) = first.a + (k−1)·j (snap 0) or the closed form; locate the sign change.
-            let k0 = (-(first.a as f64) / first.j as f64).floor() as i64 + 1;
-            for k in (k0 - 2).max(1)..=(k0 + 2).min(n as i64) {
-                let t = s
-                    .checked_advance(seg.snap, k as u64)
-                    .ok_or(ExactFailure::Overflow)?;
-                if over(&t) {
-                    return Err(ExactFailure::Limit);
+        let at = |k: u64| s.checked_advance(seg.snap, k).ok_or(ExactFailure::Overflow);
+        if seg.snap != 0 && n > 1 {
+            for k in 1..=n {
+                let t = at(k)?;
+                check_ticks(caps, cap, &t, &t)?;
+            }
+        } else {
+            let (first, end) = (at(1)?, at(n)?);
+            if first.a.signum() * end.a.signum() < 0 {
+                // Zero snap after the first tick: a(k) = first.a + (k − 1)·first.j. The last
+                // tick on the first one's side of zero, estimated and then made exact.
+                let a = |k: u64| {
+                    i128::from(k - 1)
+                        .checked_mul(first.j)
+                        .and_then(|x| x.checked_add(first.a))
+                        .ok_or(ExactFailure::Overflow)
+                };
+                let side = first.a.signum();
+                let est = (-(first.a as f64) / first.j as f64).floor() + 1.0;
+                let mut k = if est.is_finite() {
+                    (est.max(1.0) as u64).min(n)
+                } else {
+                    1
+                };
+                while k > 1 && a(k)?.signum() == -side {
+                    k -= 1;
                 }
+                while k < n && a(k + 1)?.signum() != -side {
+                    k += 1;
+                }
+                check_ticks(caps, cap, &first, &at(k)?)?;
+                check_ticks(caps, cap, &at(k + 1)?, &end)?;
+            } else {
+                check_ticks(caps, cap, &first, &end)?;
             }
         }
-        s = end;
+        s = at(n)?;
     }
     Ok(())
+}
+
+/// Checks the ticks from `p` to `q` of one segment, across which the acceleration keeps its
+/// sign (so the velocity is monotone): every register's extremes are at the two ends.
+fn check_ticks(
+    caps: &Caps,
+    cap: usize,
+    p: &ChainState,
+    q: &ChainState,
+) -> Result<(), ExactFailure> {
+    let v = (p.v.min(q.v), p.v.max(q.v));
+    let a = (p.a.min(q.a), p.a.max(q.a));
+    let mag = |r: (i128, i128)| r.0.saturating_abs().max(r.1.saturating_abs());
+    let over =
+        p.j.abs().max(q.j.abs()) > caps.j || mag(a) > caps.a_cap(v, a, cap) || mag(v) > caps.v;
+    if over {
+        Err(ExactFailure::Limit)
+    } else {
+        Ok(())
+    }
 }

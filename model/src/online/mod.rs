@@ -219,6 +219,7 @@ fn push_transition(
                     ticks: n,
                     free: None,
                     cap,
+                    slack: true,
                 });
             }
         } else {
@@ -227,6 +228,7 @@ fn push_transition(
                 ticks: ticks(p.t, 1),
                 free: Some(*free),
                 cap,
+                slack: false,
             });
             *free += 1;
         }
@@ -273,8 +275,11 @@ pub fn plan_online(
         start.v.saturating_add(start.a).saturating_abs()
     };
     let a_entry = start.a.saturating_abs().max(next_a.saturating_abs());
-    let caps = Caps {
+    let mut caps = Caps {
         v: lim.v.max(excursion_v),
+        acc: lim.acc,
+        dec: lim.dec,
+        entry: 0,
         a: [
             0, // filled per transition below
             0,
@@ -282,37 +287,147 @@ pub fn plan_online(
         ],
         j: lim.j.max(start.j.saturating_abs()),
     };
+    // A start whose acceleration is beyond the limit of its direction keeps it while its first
+    // transition brings it back.
+    let a_range = (start.a.min(next_a), start.a.max(next_a));
+    if a_entry > caps.a_cap((start.v, start.v), a_range, 1) {
+        caps.entry = a_entry;
+    }
     let mut program = Program::empty();
     // Rounding up leaves no slack when a piece lasts a whole number of ticks, and the
     // discrete chain (a rectangle rule) can then ask a level a few parts in 10⁵ above its
-    // limit. Longer pieces and slightly lower planning limits lower the levels and the cruise
-    // speed: on a limit, plan again with the next (scale, extra ticks) pair. The checks use
-    // the true limits throughout.
+    // limit; the exact position moves the cruise speed by what the rounding of every piece
+    // added. Each (scale, extra ticks) pair plans with limits lowered by the scale and every
+    // piece but the settle lengthened; `fit` then gives more ticks to a piece whose level is
+    // over its limit, and a cruise over the velocity limit lowers the planning velocity.
+    // The checks use the true limits throughout.
     let mut last = ExactFailure::Limit;
-    for (scale, extra) in [
-        (1.0, 0u64),
-        (1.0, 1),
-        (1.0 - 1e-4, 1),
-        (1.0 - 1e-3, 2),
-        (0.99, 4),
-        (0.95, 8),
-    ] {
-        let tick = TickLimits {
+    for (scale, extra) in PLANNING_SCALES {
+        let mut tick = TickLimits {
             v: lim.tick.v * scale,
             acc: lim.tick.acc * scale,
             dec: lim.tick.dec * scale,
             j: lim.tick.j * scale,
         };
-        let (problem, caps, cases, continuous) = build(
-            start, target, o, &lim, &tick, v_end, a_entry, caps, extra, format,
-        )?;
-        match exact::realise(&problem, start, &caps, &mut program) {
-            Ok(fin) => return finish(start, target, format, program, fin, continuous, cases),
-            Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
-            Err(e) => last = e,
+        for retarget in 0..=RETARGETS {
+            let (mut problem, caps, cases, continuous) = build(
+                start, target, o, &lim, &tick, v_end, a_entry, caps, extra, format,
+            )?;
+            let lin = match fit(&mut problem, start, &caps) {
+                Ok(lin) => lin,
+                Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
+                Err(e) => {
+                    last = e;
+                    break;
+                }
+            };
+            if let Some(vc) = lin.cruise_v {
+                let over = vc.abs() - caps.v as f64;
+                let lowered = tick.v - 2.0 * over - 1.0;
+                if over > 0.0 && retarget < RETARGETS && lowered > 0.5 * tick.v {
+                    tick.v = lowered;
+                    continue;
+                }
+            }
+            match exact::realise(&problem, start, &caps, &lin, &mut program) {
+                Ok(fin) => return finish(start, target, format, program, fin, continuous, cases),
+                Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
+                Err(e) => {
+                    last = e;
+                    break;
+                }
+            }
         }
     }
     Err(map(last))
+}
+
+/// The (planning scale, extra ticks) pairs [`plan_online`] tries in order: the limits the
+/// continuous profile is planned with (a fraction of the true ones) and the ticks added to
+/// every piece but the settle.
+const PLANNING_SCALES: [(f64, u64); 10] = [
+    (1.0, 0),
+    (1.0, 1),
+    (1.0 - 1e-4, 0),
+    (1.0 - 1e-4, 1),
+    (1.0 - 1e-3, 0),
+    (1.0 - 1e-3, 2),
+    (0.99, 0),
+    (0.99, 4),
+    (0.95, 0),
+    (0.95, 8),
+];
+
+/// Plans per scale with a lowered planning velocity when the level solution cruises above the
+/// velocity limit.
+const RETARGETS: usize = 2;
+
+/// Rounds of [`fit`].
+const FIT_ROUNDS: usize = 8;
+
+/// Ticks [`fit`] may add to a plan beyond those it takes from holds and the cruise.
+const FIT_GROWTH: u64 = 24;
+
+/// Fits the tick counts to the levels (docs/MODEL.md §11, "Fitting the ticks to the levels"):
+/// a free piece whose real level exceeds its limit by a ratio `r` (jerk pieces: `J`; order 2's
+/// acceleration pieces: their cap) is lengthened by `n·(√r − 1) + 1` ticks (order 3: a jerk
+/// piece's velocity change grows with `n²`; order 2: `n·(r − 1) + 1`), taken from the
+/// neighbouring hold of the same transition, else from the cruise, and the levels solved
+/// again. Ticks nobody lends lengthen the plan, at most [`FIT_GROWTH`] in all. Returns the
+/// real levels of the last solve (the limits are checked on the integers afterwards).
+fn fit(p: &mut Problem, start: &ChainState, caps: &Caps) -> Result<exact::Linear, ExactFailure> {
+    let mut grown = 0u64;
+    let mut lin = exact::linearise(p, start)?;
+    for _ in 0..FIT_ROUNDS {
+        let mut changed = false;
+        for i in 0..p.pieces.len() {
+            let d = p.pieces[i];
+            let Some(k) = d.free else { continue };
+            // Order 2's levels are accelerations: one whose sign the solve turned against the
+            // transition's direction brakes where it was planned to accelerate, or the
+            // reverse, and gets the smaller limit.
+            let limit = if p.order == 3 {
+                caps.j as f64
+            } else if lin.levels[k].signum() != p.guess[k].signum() {
+                caps.acc.min(caps.dec) as f64
+            } else {
+                caps.a[d.cap] as f64
+            };
+            let ratio = lin.levels[k].abs() / limit;
+            if !ratio.is_finite() {
+                return Err(ExactFailure::Overflow);
+            }
+            if ratio <= 1.0 - 1e-9 {
+                continue;
+            }
+            let factor = if p.order == 3 { ratio.sqrt() } else { ratio };
+            let grow = (d.ticks as f64 * (factor - 1.0)).ceil().min(1e12) as u64 + 1;
+            p.pieces[i].ticks += grow;
+            let hold = |j: usize| {
+                let h = &p.pieces[j];
+                h.slack && h.free.is_none() && h.cap == d.cap && Some(j) != p.cruise
+            };
+            let donor = [i + 1, i.wrapping_sub(1)]
+                .into_iter()
+                .find(|&j| j < p.pieces.len() && hold(j))
+                .or(p.cruise);
+            let lent = donor.map_or(0, |j| {
+                let t = grow.min(p.pieces[j].ticks.saturating_sub(1));
+                p.pieces[j].ticks -= t;
+                t
+            });
+            grown += grow - lent;
+            if grown > FIT_GROWTH {
+                return Err(ExactFailure::Limit);
+            }
+            changed = true;
+        }
+        if !changed {
+            return Ok(lin);
+        }
+        lin = exact::linearise(p, start)?;
+    }
+    Ok(lin)
 }
 
 /// The discrete problem for planning limits `tick` (true limits in `lim`), every piece but
@@ -342,6 +457,7 @@ fn build(
     let mut free = 0;
     let mut pieces = Vec::with_capacity(12);
     let mut conditions = Vec::with_capacity(4);
+    let mut cruise = None;
     let (cases, continuous, x_centre, rise, caps) = match *target {
         OnlineTarget::Velocity(_) => {
             let t = transition::velocity(o, v0, a0, v_end as f64, tick);
@@ -375,10 +491,12 @@ fn build(
             let prof: PositionProfile = position::plan(o, v0, a0, dist, v_end as f64, tick)
                 .ok_or(OnlineError::BlendUnreachable)?;
             push_transition(&mut pieces, &mut guess, &mut free, &prof.first, o, 0);
+            cruise = Some(pieces.len());
             pieces.push(DPiece {
                 ticks: ticks(prof.cruise, 1),
                 free: None,
                 cap: 2,
+                slack: true,
             });
             if o == 3 {
                 conditions.push(Condition::A(pieces.len() - 1));
@@ -411,6 +529,7 @@ fn build(
         ticks: if o == 2 { 2 } else { 1 },
         free: None,
         cap: 2,
+        slack: false,
     });
     if o == 3 {
         conditions.push(Condition::A(pieces.len() - 1));
@@ -438,6 +557,7 @@ fn build(
         approach: if rise { 1 } else { -1 },
         x_centre,
         guess,
+        cruise,
     };
     Ok((problem, caps, cases, continuous))
 }
