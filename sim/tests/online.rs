@@ -6,7 +6,7 @@
 use snapgen_model::axis::driver::{
     power_up, run, stop_limits, Action, Event, RunOptions, RunReport,
 };
-use snapgen_model::axis::{AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
+use snapgen_model::axis::{AxisErrorId, AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
 use snapgen_model::device::Design;
 use snapgen_model::online::OnlineOrder;
 use snapgen_model::timing::Timing;
@@ -508,4 +508,38 @@ fn random_scripts_land_where_the_plan_says() {
     // The online planner refuses some replans from states on its own trajectories (README,
     // issue 10's open items): a refused command is an Error, never a wrong trajectory.
     assert!(errors * 10 < commands, "{errors} of {commands} refused");
+}
+
+/// A change whose program is longer than the program memory goes up in several uploads; when
+/// the link cannot upload the rest before the board has played what it holds (many short
+/// moves due together on the slow co-simulation link), the change is refused whole with
+/// LinkTooSlow and nothing changes on the board; the same script on a fast link is played.
+#[test]
+fn a_change_the_link_cannot_keep_up_with_is_refused_whole() {
+    let script: Vec<Event> = (1..=6)
+        .map(|k| at(0.0, mv(0.05 * k as f64, 100.0, BufferMode::Buffered)))
+        .collect();
+    let r = play(&script, OnlineOrder::Three);
+    let slow = |o: &Outcome| matches!(o, Outcome::Error(AxisErrorId::LinkTooSlow { .. }));
+    assert!(outcomes(&r).iter().all(slow), "{:?}", outcomes(&r));
+    assert!(r.swaps.is_empty());
+    assert_eq!((r.last.v, r.last.a, r.last.j), (0, 0, 0));
+    assert_eq!(
+        r.last.x, r.axis.timeline.origin.1.x,
+        "the axis did not move"
+    );
+    // At 3 Mbaud on the default board the rest goes up in time.
+    let d = real_design(3_000_000);
+    let r = play_on(
+        &mut BoardLink::new(VirtualBoard::model(&d)),
+        &script,
+        OnlineOrder::Three,
+    );
+    assert!(
+        outcomes(&r).iter().all(|o| *o == Outcome::Done),
+        "{:?}",
+        outcomes(&r)
+    );
+    assert!(r.extensions > 0, "the program went up in one upload");
+    lands_on(&r, 0.3);
 }

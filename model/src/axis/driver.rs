@@ -15,6 +15,7 @@ use crate::protocol::{Command, Reason, Reply, StateReply};
 
 use super::compose::{Refusal, Request};
 use super::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
+use crate::program::Program;
 
 /// A board the host talks to.
 pub trait Link {
@@ -204,6 +205,8 @@ struct Runner<'l, L: Link> {
     covered: u64,
     /// Swaps that only uploaded the rest of a long change.
     extensions: u32,
+    /// Ticks between polls: how late the host may notice that a swap has passed.
+    poll_ticks: u64,
 }
 
 impl<L: Link> Runner<'_, L> {
@@ -290,10 +293,40 @@ impl<L: Link> Runner<'_, L> {
                     }
                 }
             };
+            if at >= self.covered && self.needs_extension() {
+                // The board would play out what it holds before this swap: upload the rest
+                // of the running change first (its swap is then waited for above).
+                self.extend()?;
+                continue;
+            }
             if c.program.segments.is_empty() {
                 // Nothing plays from `at` (the axis rests before it): no swap is needed.
                 self.axis.apply(c);
                 return Ok((None, refused));
+            }
+            if !self.coverable(&c.timeline, at, margin) {
+                // Taken, the change would leave the board without program: refused whole,
+                // nothing changes on the board.
+                let error = AxisErrorId::LinkTooSlow {
+                    segments: self.axis.settings.format.max_segments,
+                };
+                let mut all = refused;
+                for &q in reqs {
+                    if !all.iter().any(|(r, _)| *r == q) {
+                        let command = match q {
+                            Request::Command(k) => Some(k),
+                            Request::Override(_) => None,
+                        };
+                        all.push((
+                            q,
+                            Refusal {
+                                command,
+                                error: error.clone(),
+                            },
+                        ));
+                    }
+                }
+                return Ok((None, all));
             }
             match self.arm(at, &c.program)? {
                 Ok(()) => {
@@ -348,6 +381,42 @@ impl<L: Link> Runner<'_, L> {
             }
             Err(Reason::Late) => Ok(Err(())),
             Err(r) => Err(refused("SWAP_AT", r)),
+        }
+    }
+
+    /// True when the timeline goes on past the program the board holds.
+    fn needs_extension(&self) -> bool {
+        let f = self.axis.settings.format;
+        !self
+            .axis
+            .timeline
+            .program_from(self.covered, &f)
+            .segments
+            .is_empty()
+    }
+
+    /// Whether `timeline`, swapped to at `at`, can be kept on the board: each upload of at
+    /// most the program memory must be followed, once its swap has passed and been seen (a
+    /// poll later), by the upload of the rest (as [`Runner::extend`] leads it) armed before the
+    /// board has played what it holds.
+    fn coverable(&self, timeline: &super::Timeline, at: u64, margin: f64) -> bool {
+        let f = self.axis.settings.format;
+        let mut swap = at;
+        loop {
+            let rest = timeline.segments_from(swap, &f);
+            if rest.len() <= f.max_segments {
+                return true;
+            }
+            let held = Program {
+                segments: rest[..f.max_segments].to_vec(),
+            };
+            let covered = swap + held.total_ticks();
+            let lead = (self.upload_ticks(&held) * 1.25 * margin).ceil() as u64 + SAFETY;
+            let next = swap + self.poll_ticks + lead;
+            if next >= covered {
+                return false;
+            }
+            swap = next;
         }
     }
 
@@ -438,6 +507,7 @@ pub fn run<L: Link>(
         armed: None,
         covered: first.ticks,
         extensions: 0,
+        poll_ticks: ticks_of(opts.poll_ms, ts).max(1),
     };
     let start = first.ticks;
     let f = settings.format;

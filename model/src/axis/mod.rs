@@ -127,6 +127,13 @@ pub enum AxisErrorId {
     /// The board refused a command or the link failed.
     #[error("the board: {0}")]
     Board(String),
+    /// The change's program is longer than the program memory and the link cannot upload
+    /// its rest before the board has played what it holds.
+    #[error("the link is too slow for this change: its program is longer than the board's program memory ({segments} segments) and the rest cannot be uploaded before the board plays what it holds; raise the baud rate or give longer moves")]
+    LinkTooSlow {
+        /// The program memory (segments).
+        segments: usize,
+    },
     /// The board's registers differ from the host's prediction: the trajectory is not the
     /// one planned (everything stops).
     #[error("the board's registers at tick {tick} differ from the plan's")]
@@ -291,6 +298,14 @@ impl Timeline {
     /// when the last part holds a velocity, cruise segments (snap 0) while the position
     /// register holds; the first `max_segments` of them (the rest goes up in a later swap).
     pub fn program_from(&self, t: u64, format: &Format) -> Program {
+        let mut segments = self.segments_from(t, format);
+        segments.truncate(format.max_segments);
+        Program { segments }
+    }
+
+    /// What the fabric plays from tick `t` on, whole: [`Timeline::program_from`] before it
+    /// is cut to the program memory (a long change goes up in several uploads).
+    pub fn segments_from(&self, t: u64, format: &Format) -> Vec<Segment> {
         let mut segments = Vec::new();
         let mut tick = self.origin.0;
         for p in &self.parts {
@@ -321,8 +336,7 @@ impl Timeline {
                 hold(&mut segments, left.min(most));
             }
         }
-        segments.truncate(format.max_segments);
-        Program { segments }
+        segments
     }
 }
 

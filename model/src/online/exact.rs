@@ -33,6 +33,9 @@ use crate::program::{Program, Segment};
 /// Largest number of free levels.
 pub const MAX_FREE: usize = 4;
 
+/// Largest number of pieces (two transitions of three, the cruise, the settle).
+pub const MAX_PIECES: usize = 8;
+
 /// A value affine in the free levels: `c + Σ k[i]·p[i]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Affine {
@@ -159,6 +162,8 @@ pub struct Linear {
     pub levels: [f64; MAX_FREE],
     /// The velocity of the cruise piece at these levels (raw per tick), if there is one.
     pub cruise_v: Option<f64>,
+    /// The acceleration at the end of each piece at these levels (raw per tick²).
+    pub piece_a: [f64; MAX_PIECES],
 }
 
 /// Exact caps on the registers (raw magnitudes).
@@ -181,16 +186,18 @@ pub struct Caps {
 }
 
 impl Caps {
-    /// The acceleration cap of the ticks of one segment, from the velocity's and the
-    /// acceleration's ranges over them: `acc` when |v| grows on every tick, `dec` when it
-    /// shrinks without crossing zero, the smaller of the two otherwise; `entry` (cap index 0,
+    /// The acceleration cap of consecutive ticks whose acceleration keeps its sign, from the
+    /// velocity's and the acceleration's ranges over them and the velocity after the last
+    /// (what the last acceleration leads to): `acc` when |v| grows on every tick, `dec` when
+    /// it shrinks without crossing zero, the smaller of the two otherwise; `entry` (cap index 0,
     /// the first transition) raises it for a start beyond its limits.
-    pub fn a_cap(&self, v: (i128, i128), a: (i128, i128), cap: usize) -> i128 {
+    pub fn a_cap(&self, v: (i128, i128), a: (i128, i128), v_after: i128, cap: usize) -> i128 {
         let (v_lo, v_hi) = v;
         let (a_lo, a_hi) = a;
         let grows = (v_lo >= 0 && a_lo >= 0) || (v_hi <= 0 && a_hi <= 0);
-        let shrinks = (v_lo > 0 && a_hi <= 0 && v_lo.saturating_add(a_lo) >= 0)
-            || (v_hi < 0 && a_lo >= 0 && v_hi.saturating_add(a_hi) <= 0);
+        // Shrinking toward zero, the velocity is closest to it after the last tick.
+        let shrinks =
+            (v_lo > 0 && a_hi <= 0 && v_after >= 0) || (v_hi < 0 && a_lo >= 0 && v_after <= 0);
         let by_direction = if grows {
             self.acc
         } else if shrinks {
@@ -380,6 +387,9 @@ fn round_levels(l: &[f64; MAX_FREE], n: usize) -> Option<[i128; MAX_FREE]> {
 /// Step 2 of the module documentation: the real levels that meet the end conditions with the
 /// tick counts of `p`, from `start`.
 pub fn linearise(p: &Problem, start: &ChainState) -> Result<Linear, ExactFailure> {
+    if p.pieces.len() > MAX_PIECES {
+        return Err(ExactFailure::Singular);
+    }
     let n = p.free;
     let aim = aim(p);
     // 2. The linear map, in f64: F₀ from the start, columns from rest.
@@ -437,18 +447,23 @@ pub fn linearise(p: &Problem, start: &ChainState) -> Result<Linear, ExactFailure
     for q in 0..n {
         levels[q] += r[q];
     }
-    let cruise_v = p.cruise.map(|c| {
-        let v = piece_end_v[c];
-        v.c + v.k[..n]
+    let value = |f: &Affine| {
+        f.c + f.k[..n]
             .iter()
             .zip(&levels[..n])
             .map(|(k, l)| k * l)
             .sum::<f64>()
-    });
+    };
+    let cruise_v = p.cruise.map(|c| value(&piece_end_v[c]));
+    let mut piece_a = [0.0; MAX_PIECES];
+    for (out, a) in piece_a.iter_mut().zip(&piece_end_a) {
+        *out = value(a);
+    }
     Ok(Linear {
         m,
         levels,
         cruise_v,
+        piece_a,
     })
 }
 
@@ -576,8 +591,9 @@ fn check_ticks(
     let v = (p.v.min(q.v), p.v.max(q.v));
     let a = (p.a.min(q.a), p.a.max(q.a));
     let mag = |r: (i128, i128)| r.0.saturating_abs().max(r.1.saturating_abs());
-    let over =
-        p.j.abs().max(q.j.abs()) > caps.j || mag(a) > caps.a_cap(v, a, cap) || mag(v) > caps.v;
+    let over = p.j.abs().max(q.j.abs()) > caps.j
+        || mag(a) > caps.a_cap(v, a, q.v.saturating_add(q.a), cap)
+        || mag(v) > caps.v;
     if over {
         Err(ExactFailure::Limit)
     } else {

@@ -290,7 +290,14 @@ pub fn plan_online(
     // A start whose acceleration is beyond the limit of its direction keeps it while its first
     // transition brings it back.
     let a_range = (start.a.min(next_a), start.a.max(next_a));
-    if a_entry > caps.a_cap((start.v, start.v), a_range, 1) {
+    if a_entry
+        > caps.a_cap(
+            (start.v, start.v),
+            a_range,
+            start.v.saturating_add(start.a),
+            1,
+        )
+    {
         caps.entry = a_entry;
     }
     let mut program = Program::empty();
@@ -368,13 +375,20 @@ const FIT_ROUNDS: usize = 8;
 /// Ticks [`fit`] may add to a plan beyond those it takes from holds and the cruise.
 const FIT_GROWTH: u64 = 24;
 
-/// Fits the tick counts to the levels (docs/MODEL.md §11, "Fitting the ticks to the levels"):
-/// a free piece whose real level exceeds its limit by a ratio `r` (jerk pieces: `J`; order 2's
-/// acceleration pieces: their cap) is lengthened by `n·(√r − 1) + 1` ticks (order 3: a jerk
-/// piece's velocity change grows with `n²`; order 2: `n·(r − 1) + 1`), taken from the
-/// neighbouring hold of the same transition, else from the cruise, and the levels solved
-/// again. Ticks nobody lends lengthen the plan, at most [`FIT_GROWTH`] in all. Returns the
-/// real levels of the last solve (the limits are checked on the integers afterwards).
+/// Fits the tick counts to the levels (docs/MODEL.md §11, "Fitting the ticks to the levels"),
+/// on the real solution of the level equations:
+///
+/// * a free piece whose level exceeds its limit by a ratio `r` (order 3: the jerk; order 2:
+///   the acceleration) is lengthened by `n·(√r − 1) + 1` ticks (order 3: a jerk piece's
+///   velocity change grows with `n²`) or `n·(r − 1) + 1` (order 2);
+/// * a hold (order 3) whose acceleration exceeds its limit by `r` is lengthened by
+///   `(n + m)·(r − 1) + 1`, `m` the ticks of the jerk pieces beside it (its velocity change
+///   grows with `n + m`);
+///
+/// the ticks taken (a jerk piece) from the hold beside it, else from the cruise where there
+/// is one, and the levels solved again. Ticks nobody lends lengthen the plan, at most
+/// [`FIT_GROWTH`] in all. Returns the real solution of the last solve (the limits are checked
+/// on the integers afterwards).
 fn fit(p: &mut Problem, start: &ChainState, caps: &Caps) -> Result<exact::Linear, ExactFailure> {
     let mut grown = 0u64;
     let mut lin = exact::linearise(p, start)?;
@@ -382,35 +396,66 @@ fn fit(p: &mut Problem, start: &ChainState, caps: &Caps) -> Result<exact::Linear
         let mut changed = false;
         for i in 0..p.pieces.len() {
             let d = p.pieces[i];
-            let Some(k) = d.free else { continue };
-            // Order 2's levels are accelerations: one whose sign the solve turned against the
-            // transition's direction brakes where it was planned to accelerate, or the
-            // reverse, and gets the smaller limit.
-            let limit = if p.order == 3 {
-                caps.j as f64
-            } else if lin.levels[k].signum() != p.guess[k].signum() {
-                caps.acc.min(caps.dec) as f64
-            } else {
-                caps.a[d.cap] as f64
+            let is_hold = |j: usize| {
+                j < p.pieces.len() && {
+                    let h = &p.pieces[j];
+                    h.slack && h.free.is_none() && h.cap == d.cap && Some(j) != p.cruise
+                }
             };
-            let ratio = lin.levels[k].abs() / limit;
-            if !ratio.is_finite() {
-                return Err(ExactFailure::Overflow);
-            }
-            if ratio <= 1.0 - 1e-9 {
-                continue;
-            }
-            let factor = if p.order == 3 { ratio.sqrt() } else { ratio };
-            let grow = (d.ticks as f64 * (factor - 1.0)).ceil().min(1e12) as u64 + 1;
+            let jerk_ticks = |j: usize| {
+                p.pieces
+                    .get(j)
+                    .filter(|q| q.free.is_some())
+                    .map_or(0, |q| q.ticks)
+            };
+            // The planned sign of a piece's level or acceleration: the guess of its level, or
+            // (a hold) of the jerk piece before it. The other sign gets the smaller limit.
+            let limit = |value: f64, planned: f64| {
+                if value.signum() != planned.signum() {
+                    caps.acc.min(caps.dec) as f64
+                } else {
+                    caps.a[d.cap] as f64
+                }
+            };
+            let grow = match d.free {
+                Some(k) => {
+                    let level = lin.levels[k];
+                    let ratio = if p.order == 3 {
+                        level.abs() / caps.j as f64
+                    } else {
+                        level.abs() / limit(level, p.guess[k])
+                    };
+                    if !ratio.is_finite() {
+                        return Err(ExactFailure::Overflow);
+                    }
+                    if ratio <= 1.0 - 1e-9 {
+                        continue;
+                    }
+                    let factor = if p.order == 3 { ratio.sqrt() } else { ratio };
+                    (d.ticks as f64 * (factor - 1.0)).ceil().min(1e12) as u64 + 1
+                }
+                None if p.order == 3 && is_hold(i) && i > 0 => {
+                    let a = lin.piece_a[i];
+                    let planned = p.pieces[i - 1].free.map_or(a, |k| p.guess[k]);
+                    let ratio = a.abs() / limit(a, planned);
+                    if !ratio.is_finite() {
+                        return Err(ExactFailure::Overflow);
+                    }
+                    if ratio <= 1.0 - 1e-9 {
+                        continue;
+                    }
+                    let span = d.ticks + jerk_ticks(i - 1) + jerk_ticks(i + 1);
+                    (span as f64 * (ratio - 1.0)).ceil().min(1e12) as u64 + 1
+                }
+                None => continue,
+            };
+            let hold_beside = [i + 1, i.wrapping_sub(1)].into_iter().find(|&j| is_hold(j));
             p.pieces[i].ticks += grow;
-            let hold = |j: usize| {
-                let h = &p.pieces[j];
-                h.slack && h.free.is_none() && h.cap == d.cap && Some(j) != p.cruise
+            let donor = if d.free.is_some() {
+                hold_beside.or(p.cruise)
+            } else {
+                p.cruise
             };
-            let donor = [i + 1, i.wrapping_sub(1)]
-                .into_iter()
-                .find(|&j| j < p.pieces.len() && hold(j))
-                .or(p.cruise);
             let lent = donor.map_or(0, |j| {
                 let t = grow.min(p.pieces[j].ticks.saturating_sub(1));
                 p.pieces[j].ticks -= t;
