@@ -325,7 +325,7 @@ fn a_state_beyond_lowered_limits_comes_back_without_reversal() {
 }
 
 /// Bounds met on the seeded set (docs/MODEL.md §11): ticks over Ruckig, median and 90th
-/// percentile (measured 7.9 and 14.3).
+/// percentile (measured 7.7 and 12.2).
 const MEDIAN_ABOVE_RUCKIG: f64 = 10.0;
 const P90_ABOVE_RUCKIG: f64 = 20.0;
 
@@ -403,8 +403,8 @@ fn durations_against_ruckig_and_refusals() {
         "{:.2} ticks faster than Ruckig",
         -diffs[0]
     );
-    // The bound met on most states; the tail (measured p99 81 ticks, worst 33 % of the move on
-    // a reversal) is a known gap, reported above and in docs/MODEL.md §11.
+    // The bound met on most states; the tail (measured p99 24 ticks, worst 5.7 % of the move
+    // on a reversal) is a known gap, reported above and in docs/MODEL.md §11.
     assert!(
         diffs[n / 2] <= MEDIAN_ABOVE_RUCKIG,
         "median {:.2} ticks over Ruckig",
