@@ -26,8 +26,14 @@
 //! The result is checked, not assumed: the final state must be exactly the requested one and
 //! the position in the target cell, and the exact per-tick peaks of every segment
 //! ([`check_limits`]) must stay within the limits.
+//!
+//! Everything is computed a *piece* at a time in closed form (a piece: its jerk set on its
+//! first tick, held for the rest), in `f64` for the solve and in checked `i128` for the
+//! integers; the program's segments are written once, from the final levels.
 
-use crate::chain::{binomial, ChainState};
+use arrayvec::ArrayVec;
+
+use crate::chain::ChainState;
 use crate::program::{Program, Segment};
 
 /// Largest number of free levels.
@@ -36,38 +42,28 @@ pub const MAX_FREE: usize = 4;
 /// Largest number of pieces (two transitions of three, the cruise, the settle).
 pub const MAX_PIECES: usize = 8;
 
-/// A value affine in the free levels: `c + Σ k[i]·p[i]`.
+/// Largest number of jerk pieces: order 2 plays each piece as an impulse and a hold.
+const MAX_JERK_PIECES: usize = 2 * MAX_PIECES;
+
+/// A value affine in the free levels: `c + Σ k[i]·p[i]`, stored `[c, k₀, k₁, k₂, k₃]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Affine {
-    c: f64,
-    k: [f64; MAX_FREE],
-}
+struct Affine([f64; MAX_FREE + 1]);
 
 impl Affine {
     fn constant(c: f64) -> Self {
-        Affine {
-            c,
-            ..Default::default()
-        }
-    }
-
-    fn param(i: usize) -> Self {
         let mut a = Affine::default();
-        a.k[i] = 1.0;
+        a.0[0] = c;
         a
     }
 
-    fn add(&self, o: &Affine, m: f64) -> Affine {
-        let mut r = *self;
-        r.c += m * o.c;
-        for i in 0..MAX_FREE {
-            r.k[i] += m * o.k[i];
-        }
-        r
+    /// The coefficients of the levels.
+    fn k(&self) -> &[f64] {
+        &self.0[1..]
     }
 
-    fn sub(&self, o: &Affine) -> Affine {
-        self.add(o, -1.0)
+    /// The value at levels `p`.
+    fn at(&self, p: &[f64; MAX_FREE]) -> f64 {
+        self.0[0] + self.0[1] * p[0] + self.0[2] * p[1] + self.0[3] * p[2] + self.0[4] * p[3]
     }
 }
 
@@ -80,26 +76,111 @@ struct AffineState {
     j: Affine,
 }
 
+/// The closed-form coefficients of `m` ticks at constant jerk: `C(m,1)`, `C(m,2)`, `C(m,3)`.
+#[inline(always)]
+fn binomials_f(m: u64) -> (f64, f64, f64) {
+    let m = m as f64;
+    let c2 = m * (m - 1.0) * 0.5;
+    (m, c2, c2 * (m - 2.0) / 3.0)
+}
+
 impl AffineState {
     /// `n ≥ 1` ticks with the jerk held at `level` from the first tick (snap `level − j` on the
-    /// first tick, zero after).
-    fn jerk_piece(&self, level: &Affine, n: u64) -> AffineState {
-        // First tick: every register from the previous tick's values.
-        let s = AffineState {
-            x: self.x.add(&self.v, 1.0),
-            v: self.v.add(&self.a, 1.0),
-            a: self.a.add(&self.j, 1.0),
-            j: *level,
-        };
-        let m = n - 1;
-        let c = |k| binomial(m, k) as f64;
-        AffineState {
-            x: s.x.add(&s.v, c(1)).add(&s.a, c(2)).add(&s.j, c(3)),
-            v: s.v.add(&s.a, c(1)).add(&s.j, c(2)),
-            a: s.a.add(&s.j, c(1)),
-            j: s.j,
+    /// first tick, zero after): the closed form of [`piece_end`], lane by lane.
+    fn jerk_piece(&mut self, level: &Affine, n: u64) {
+        let (c1, c2, c3) = binomials_f(n - 1);
+        for i in 0..=MAX_FREE {
+            // First tick: every register from the previous tick's values.
+            let (x, v, a) = (
+                self.x.0[i] + self.v.0[i],
+                self.v.0[i] + self.a.0[i],
+                self.a.0[i] + self.j.0[i],
+            );
+            let l = level.0[i];
+            self.x.0[i] = x + c1 * v + c2 * a + c3 * l;
+            self.v.0[i] = v + c1 * a + c2 * l;
+            self.a.0[i] = a + c1 * l;
+            self.j.0[i] = l;
         }
     }
+}
+
+/// The closed form of `n ≥ 1` ticks whose jerk is `level` from the first tick, exactly;
+/// `None` when a register leaves `i128`. Equal to playing a one-tick segment of snap
+/// `level − j` and an `(n − 1)`-tick segment of zero snap.
+#[inline]
+pub fn piece_end(s: &ChainState, level: i128, n: u64) -> Option<ChainState> {
+    let x1 = s.x.checked_add(s.v)?;
+    let v1 = s.v.checked_add(s.a)?;
+    let a1 = s.a.checked_add(s.j)?;
+    zero_snap(
+        &ChainState {
+            x: x1,
+            v: v1,
+            a: a1,
+            j: level,
+        },
+        n - 1,
+    )
+}
+
+/// `a·b`, `None` when it leaves `i128`: one wrapping multiplication when the operands' bit
+/// lengths prove it cannot overflow (the usual case), the checked library routine otherwise.
+#[inline(always)]
+fn mul(a: i128, b: i128) -> Option<i128> {
+    let bits = |x: i128| 128 - x.unsigned_abs().leading_zeros();
+    if bits(a) + bits(b) <= 126 {
+        Some(a.wrapping_mul(b))
+    } else {
+        a.checked_mul(b)
+    }
+}
+
+/// `v` as an f64, from its two 64-bit halves: two hardware conversions and one fused step
+/// instead of the library's 128-bit routine. Within an ulp or two of `v as f64` (what the
+/// real-valued solve needs) and, being plain IEEE-754 arithmetic, the same on every platform.
+#[inline(always)]
+pub fn to_f64(v: i128) -> f64 {
+    let (hi, lo) = ((v >> 64) as i64, v as i64);
+    if hi == lo >> 63 {
+        // Fits an i64.
+        return lo as f64;
+    }
+    hi as f64 * 18_446_744_073_709_551_616.0 + (v as u64) as f64
+}
+
+/// `m` ticks of zero snap from `s` in closed form (`m < 2^42`), exactly; `None` when a
+/// register leaves `i128`.
+#[inline]
+fn zero_snap(s: &ChainState, m: u64) -> Option<ChainState> {
+    if m == 0 {
+        return Some(*s);
+    }
+    let m = u128::from(m);
+    let c2 = m * (m - 1) / 2;
+    // C(m,3) = C(m,2)·(m − 2)/3, exact: 3 divides m(m−1)(m−2).
+    let c3 = c2 * m.saturating_sub(2) / 3;
+    let (c1, c2, c3) = (m as i128, c2 as i128, i128::try_from(c3).ok()?);
+    Some(ChainState {
+        x: s.x
+            .checked_add(mul(c1, s.v)?)?
+            .checked_add(mul(c2, s.a)?)?
+            .checked_add(mul(c3, s.j)?)?,
+        v: s.v.checked_add(mul(c1, s.a)?)?.checked_add(mul(c2, s.j)?)?,
+        a: s.a.checked_add(mul(c1, s.j)?)?,
+        j: s.j,
+    })
+}
+
+/// One tick with snap `d`, exactly.
+#[inline]
+fn one_tick(s: &ChainState, d: i128) -> Option<ChainState> {
+    Some(ChainState {
+        x: s.x.checked_add(s.v)?,
+        v: s.v.checked_add(s.a)?,
+        a: s.a.checked_add(s.j)?,
+        j: s.j.checked_add(d)?,
+    })
 }
 
 /// One discrete piece of the profile: `ticks` ticks of the highest derivative at a level that is
@@ -134,18 +215,18 @@ pub struct Problem {
     /// Profile order (3: levels are jerks; 2: levels are accelerations).
     pub order: u8,
     /// Pieces, in play order; the last one is the settle piece.
-    pub pieces: Vec<DPiece>,
+    pub pieces: ArrayVec<DPiece, MAX_PIECES>,
     /// Number of free levels.
     pub free: usize,
     /// Conditions (as many as free levels).
-    pub conditions: Vec<Condition>,
+    pub conditions: ArrayVec<Condition, MAX_FREE>,
     /// End velocity (raw per tick).
     pub v_end: i128,
     /// Side the end velocity is approached from: `+1` from below (a rising last transition),
     /// `−1` from above.
     pub approach: i128,
     /// Position the end of the tail must reach (raw: the centre of the target cell).
-    pub x_centre: f64,
+    pub x_centre: i128,
     /// Initial guess of the free levels (from the continuous profile).
     pub guess: [f64; MAX_FREE],
     /// Index of the cruise piece (position targets).
@@ -156,8 +237,8 @@ pub struct Problem {
 /// checks against the limits before it asks for integers.
 #[derive(Clone, Copy, Debug)]
 pub struct Linear {
-    /// The end conditions' matrix (rows: conditions, columns: free levels).
-    m: [[f64; MAX_FREE]; MAX_FREE],
+    /// The end conditions' matrix (rows: conditions, columns: free levels), factored.
+    lu: Lu,
     /// The real levels.
     pub levels: [f64; MAX_FREE],
     /// The velocity of the cruise piece at these levels (raw per tick), if there is one.
@@ -224,125 +305,299 @@ pub enum ExactFailure {
     Limit,
 }
 
-/// The jerk-level pieces of a problem, affine in the levels: order 3 as given; order 2 turns
-/// each acceleration level `A` into a jerk impulse `A − A_prev` on its first tick.
-fn jerk_pieces(p: &Problem, start: &ChainState) -> Vec<(u64, Affine, usize)> {
-    let level = |d: &DPiece| d.free.map_or(Affine::default(), Affine::param);
-    let mut out = Vec::with_capacity(p.pieces.len() * 2);
-    if p.order == 2 {
+/// The jerk of a jerk piece: `c + p[plus] − p[minus]` (order 3: a free level or zero; order 2:
+/// the impulse from the previous acceleration level to this one).
+#[derive(Clone, Copy, Debug)]
+struct JerkLevel {
+    c: i128,
+    plus: Option<usize>,
+    minus: Option<usize>,
+}
+
+impl JerkLevel {
+    fn affine(&self) -> Affine {
+        let mut a = Affine::constant(to_f64(self.c));
+        if let Some(i) = self.plus {
+            a.0[1 + i] += 1.0;
+        }
+        if let Some(i) = self.minus {
+            a.0[1 + i] -= 1.0;
+        }
+        a
+    }
+
+    fn exact(&self, lv: &[i128; MAX_FREE]) -> Option<i128> {
+        let mut l = self.c;
+        if let Some(i) = self.plus {
+            l = l.checked_add(lv[i])?;
+        }
+        if let Some(i) = self.minus {
+            l = l.checked_sub(lv[i])?;
+        }
+        Some(l)
+    }
+}
+
+/// A jerk piece: ticks, jerk, the cap index, and whether it ends its problem piece.
+#[derive(Clone, Copy, Debug)]
+struct JerkPiece {
+    ticks: u64,
+    level: JerkLevel,
+    cap: usize,
+    ends_piece: bool,
+}
+
+/// The jerk pieces of a problem, generated in play order: order 3 as given; order 2 turns each
+/// acceleration level `A` into a jerk impulse `A − A_prev` on its first tick and zero jerk for
+/// the rest.
+#[derive(Clone)]
+struct JerkPieces<'p> {
+    p: &'p Problem,
+    /// The next problem piece.
+    i: usize,
+    /// Order 2: the impulse of piece `i` was given, its hold comes next.
+    hold_next: bool,
+    /// Order 2: the acceleration level before piece `i`.
+    prev: JerkLevel,
+}
+
+const ZERO_JERK: JerkLevel = JerkLevel {
+    c: 0,
+    plus: None,
+    minus: None,
+};
+
+fn jerk_pieces<'p>(p: &'p Problem, start: &ChainState) -> JerkPieces<'p> {
+    JerkPieces {
+        p,
+        i: 0,
+        hold_next: false,
         // The acceleration of the first tick is already decided: a + j.
-        let mut prev = Affine::constant((start.a + start.j) as f64);
-        for d in &p.pieces {
-            let l = level(d);
-            out.push((1, l.sub(&prev), d.cap));
-            if d.ticks > 1 {
-                out.push((d.ticks - 1, Affine::default(), d.cap));
-            }
-            prev = l;
-        }
-    } else {
-        for d in &p.pieces {
-            out.push((d.ticks, level(d), d.cap));
-        }
+        prev: JerkLevel {
+            c: start.a.saturating_add(start.j),
+            plus: None,
+            minus: None,
+        },
     }
-    out
 }
 
-/// Solves the square system `m·x = r` (n ≤ 4) by Gaussian elimination with partial pivoting.
-fn solve(m: &mut [[f64; MAX_FREE]; MAX_FREE], r: &mut [f64; MAX_FREE], n: usize) -> Option<()> {
-    for col in 0..n {
-        let piv = (col..n).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
-        if m[piv][col] == 0.0 || !m[piv][col].is_finite() {
-            return None;
+impl Iterator for JerkPieces<'_> {
+    type Item = JerkPiece;
+
+    #[inline]
+    fn next(&mut self) -> Option<JerkPiece> {
+        let d = self.p.pieces.get(self.i)?;
+        if self.p.order != 2 {
+            self.i += 1;
+            return Some(JerkPiece {
+                ticks: d.ticks,
+                level: JerkLevel {
+                    c: 0,
+                    plus: d.free,
+                    minus: None,
+                },
+                cap: d.cap,
+                ends_piece: true,
+            });
         }
-        m.swap(col, piv);
-        r.swap(col, piv);
-        for row in col + 1..n {
-            let f = m[row][col] / m[col][col];
-            let pivot_row = m[col];
-            for (x, p) in m[row][col..n].iter_mut().zip(&pivot_row[col..n]) {
-                *x -= f * p;
-            }
-            r[row] -= f * r[col];
+        if self.hold_next {
+            self.hold_next = false;
+            self.i += 1;
+            return Some(JerkPiece {
+                ticks: d.ticks - 1,
+                level: ZERO_JERK,
+                cap: d.cap,
+                ends_piece: true,
+            });
         }
+        let impulse = JerkLevel {
+            c: -self.prev.c,
+            plus: d.free,
+            minus: self.prev.plus,
+        };
+        self.prev = JerkLevel {
+            c: 0,
+            plus: d.free,
+            minus: None,
+        };
+        if d.ticks > 1 {
+            self.hold_next = true;
+        } else {
+            self.i += 1;
+        }
+        Some(JerkPiece {
+            ticks: 1,
+            level: impulse,
+            cap: d.cap,
+            ends_piece: d.ticks == 1,
+        })
     }
-    for col in (0..n).rev() {
-        let mut s = r[col];
-        for k in col + 1..n {
-            s -= m[col][k] * r[k];
-        }
-        r[col] = s / m[col][col];
-        if !r[col].is_finite() {
-            return None;
-        }
-    }
-    Some(())
 }
 
-/// The program for integer levels `lv` (order 3: jerks; order 2: accelerations), without the
-/// tail, and the exact states at the end of every piece.
-fn integer_program(
-    p: &Problem,
+/// An LU factorisation (partial pivoting) of the `n × n` (n ≤ 4) condition matrix: factored
+/// once per tick layout, solved for the real levels and again for each integer refinement.
+#[derive(Clone, Copy, Debug)]
+struct Lu {
+    lu: [[f64; MAX_FREE]; MAX_FREE],
+    perm: [usize; MAX_FREE],
+    n: usize,
+}
+
+impl Lu {
+    /// Factors `m`; `None` when it is singular.
+    fn new(m: &[[f64; MAX_FREE]; MAX_FREE], n: usize) -> Option<Lu> {
+        let mut lu = *m;
+        let mut perm = [0, 1, 2, 3];
+        for col in 0..n {
+            let mut piv = col;
+            for row in col + 1..n {
+                if lu[row][col].abs() > lu[piv][col].abs() {
+                    piv = row;
+                }
+            }
+            if lu[piv][col] == 0.0 || !lu[piv][col].is_finite() {
+                return None;
+            }
+            lu.swap(col, piv);
+            perm.swap(col, piv);
+            let pivot_row = lu[col];
+            for row in lu[col + 1..n].iter_mut() {
+                let f = row[col] / pivot_row[col];
+                row[col] = f;
+                for (x, p) in row[col + 1..n].iter_mut().zip(&pivot_row[col + 1..n]) {
+                    *x -= f * p;
+                }
+            }
+        }
+        Some(Lu { lu, perm, n })
+    }
+
+    /// Solves `m·x = r`; `None` when a component is not finite.
+    fn solve(&self, r: &[f64; MAX_FREE]) -> Option<[f64; MAX_FREE]> {
+        let n = self.n;
+        let mut y = [0.0; MAX_FREE];
+        for i in 0..n {
+            let dot: f64 = self.lu[i][..i].iter().zip(&y[..i]).map(|(l, y)| l * y).sum();
+            y[i] = r[self.perm[i]] - dot;
+        }
+        for i in (0..n).rev() {
+            let dot: f64 = self.lu[i][i + 1..n]
+                .iter()
+                .zip(&y[i + 1..n])
+                .map(|(l, y)| l * y)
+                .sum();
+            y[i] = (y[i] - dot) / self.lu[i][i];
+            if !y[i].is_finite() {
+                return None;
+            }
+        }
+        Some(y)
+    }
+}
+
+/// The exact states at the end of every jerk piece for integer levels `lv` (order 3: jerks;
+/// order 2: accelerations), without the tail, into `ends`; `at` receives the index of the jerk
+/// piece that ends each problem piece.
+fn piece_ends(
+    jp: JerkPieces,
     start: &ChainState,
     lv: &[i128; MAX_FREE],
-    out: &mut Program,
-    caps_of: &mut Vec<usize>,
-    ends: &mut Vec<ChainState>,
+    ends: &mut ArrayVec<ChainState, MAX_JERK_PIECES>,
+    at: &mut ArrayVec<usize, MAX_PIECES>,
 ) -> Result<(), ExactFailure> {
-    out.segments.clear();
-    caps_of.clear();
     ends.clear();
-    let level = |d: &DPiece| d.free.map_or(0, |i| lv[i]);
+    at.clear();
     let mut s = *start;
-    let mut push = |out: &mut Program, s: &mut ChainState, ticks: u64, snap: i128, cap: usize| {
-        let mut left = ticks;
-        let mut snap = snap;
-        while left > 0 {
-            let n = left.min(u64::from(u32::MAX));
-            *s = s.checked_advance(snap, n).ok_or(ExactFailure::Overflow)?;
-            out.segments.push(Segment {
-                ticks: n as u32,
-                snap,
-            });
-            caps_of.push(cap);
-            left -= n;
-            snap = 0;
-        }
-        Ok(())
-    };
-    // Jerk levels per piece (order 2: the impulse `A − A_prev` then zero), played as one
-    // snap impulse to the level and zero snap for the rest of the piece.
-    let mut prev = start.a.checked_add(start.j).ok_or(ExactFailure::Overflow)?;
-    for d in &p.pieces {
-        let l = level(d);
-        let parts: [(u64, i128); 2] = if p.order == 2 {
-            let jump = l.checked_sub(prev).ok_or(ExactFailure::Overflow)?;
-            prev = l;
-            [(1, jump), (d.ticks - 1, 0)]
-        } else {
-            [(d.ticks, l), (0, 0)]
-        };
-        for (ticks, jerk) in parts {
-            if ticks == 0 {
-                continue;
-            }
-            let snap = jerk.checked_sub(s.j).ok_or(ExactFailure::Overflow)?;
-            push(out, &mut s, 1, snap, d.cap)?;
-            push(out, &mut s, ticks - 1, 0, d.cap)?;
+    for q in jp {
+        let l = q.level.exact(lv).ok_or(ExactFailure::Overflow)?;
+        s = piece_end(&s, l, q.ticks).ok_or(ExactFailure::Overflow)?;
+        if q.ends_piece {
+            at.push(ends.len());
         }
         ends.push(s);
     }
     Ok(())
 }
 
+/// Checks every tick of the jerk pieces `jp` at levels `lv` from `start` against the caps,
+/// given the exact state at the end of each (`ends`, from [`piece_ends`]): the same checks, on
+/// the same segments, as [`check_limits`] on the program [`write_program`] writes, without
+/// playing the segments again.
+fn check_pieces(
+    jp: JerkPieces,
+    start: &ChainState,
+    lv: &[i128; MAX_FREE],
+    ends: &[ChainState],
+    caps: &Caps,
+) -> Result<(), ExactFailure> {
+    let ov = ExactFailure::Overflow;
+    let mut s = *start;
+    for (q, end) in jp.zip(ends) {
+        let l = q.level.exact(lv).ok_or(ov)?;
+        // The one-tick segment that sets the jerk.
+        let first = one_tick(&s, l.checked_sub(s.j).ok_or(ov)?).ok_or(ov)?;
+        check_ticks(caps, q.cap, &first, &first)?;
+        let rest = q.ticks - 1;
+        if rest <= u64::from(u32::MAX) {
+            if rest > 0 {
+                check_run(caps, q.cap, &first, end, rest)?;
+            }
+        } else {
+            // Written in segments of at most u32::MAX ticks: each checked on its own.
+            let mut from = first;
+            let mut left = rest;
+            while left > 0 {
+                let n = left.min(u64::from(u32::MAX));
+                let to = zero_snap(&from, n).ok_or(ov)?;
+                check_run(caps, q.cap, &from, &to, n)?;
+                from = to;
+                left -= n;
+            }
+        }
+        s = *end;
+    }
+    Ok(())
+}
+
+/// Writes the program of integer levels `lv` into `out`: a one-tick segment setting each jerk
+/// piece's jerk, then its zero-snap rest in segments of at most `u32::MAX` ticks.
+fn write_program(
+    jp: JerkPieces,
+    start: &ChainState,
+    lv: &[i128; MAX_FREE],
+    out: &mut Program,
+) -> Result<(), ExactFailure> {
+    out.segments.clear();
+    out.segments.reserve(2 * MAX_JERK_PIECES + 3);
+    let mut j = start.j;
+    for q in jp {
+        let l = q.level.exact(lv).ok_or(ExactFailure::Overflow)?;
+        out.segments.push(Segment {
+            ticks: 1,
+            snap: l.checked_sub(j).ok_or(ExactFailure::Overflow)?,
+        });
+        j = l;
+        let mut left = q.ticks - 1;
+        while left > 0 {
+            let n = left.min(u64::from(u32::MAX));
+            out.segments.push(Segment {
+                ticks: n as u32,
+                snap: 0,
+            });
+            left -= n;
+        }
+    }
+    Ok(())
+}
+
 /// The residual of the conditions for the exact states `ends` (goal minus actual).
-fn residual(p: &Problem, aim: &Aim, ends: &[ChainState], r: &mut [f64; MAX_FREE]) {
+fn residual(p: &Problem, aim: &Aim, ends: &[ChainState], at: &[usize], r: &mut [f64; MAX_FREE]) {
     let last = ends[ends.len() - 1];
     for (i, c) in p.conditions.iter().enumerate() {
         r[i] = match *c {
-            Condition::A(k) => -(ends[k].a as f64),
-            Condition::V => (aim.v - last.v) as f64,
-            Condition::X => aim.x - last.x as f64,
+            Condition::A(k) => -to_f64(ends[at[k]].a),
+            Condition::V => to_f64(aim.v.saturating_sub(last.v)),
+            Condition::X => to_f64(aim.x.saturating_sub(last.x)),
         };
     }
 }
@@ -357,18 +612,19 @@ fn residual(p: &Problem, aim: &Aim, ends: &[ChainState], r: &mut [f64; MAX_FREE]
 /// does not depend on the tail's snaps).
 struct Aim {
     v: i128,
-    x: f64,
+    x: i128,
 }
 
-fn aim(p: &Problem) -> Aim {
+fn aim(p: &Problem) -> Result<Aim, ExactFailure> {
     let n: u64 = p.pieces.iter().map(|d| d.ticks).sum();
     let n = i128::from(n.min(1 << 40));
     let m = 2 * n * n + (1 << 20);
     let v = p.v_end - p.approach * m;
-    Aim {
-        v,
-        x: p.x_centre - 3.0 * v as f64,
-    }
+    let x = v
+        .checked_mul(3)
+        .and_then(|t| p.x_centre.checked_sub(t))
+        .ok_or(ExactFailure::Overflow)?;
+    Ok(Aim { v, x })
 }
 
 /// Rounds real levels to integers (`None` if one is not finite or too large).
@@ -379,7 +635,12 @@ fn round_levels(l: &[f64; MAX_FREE], n: usize) -> Option<[i128; MAX_FREE]> {
         if !r.is_finite() || r.abs() >= 1.6e38 {
             return None;
         }
-        out[i] = r as i128;
+        // f64 → i64 is one instruction, f64 → i128 a library call.
+        out[i] = if r.abs() < 9.2e18 {
+            i128::from(r as i64)
+        } else {
+            r as i128
+        };
     }
     Some(out)
 }
@@ -387,80 +648,61 @@ fn round_levels(l: &[f64; MAX_FREE], n: usize) -> Option<[i128; MAX_FREE]> {
 /// Step 2 of the module documentation: the real levels that meet the end conditions with the
 /// tick counts of `p`, from `start`.
 pub fn linearise(p: &Problem, start: &ChainState) -> Result<Linear, ExactFailure> {
-    if p.pieces.len() > MAX_PIECES {
-        return Err(ExactFailure::Singular);
-    }
     let n = p.free;
-    let aim = aim(p);
-    // 2. The linear map, in f64: F₀ from the start, columns from rest.
-    let pieces = jerk_pieces(p, start);
+    let aim = aim(p)?;
+    // The linear map, in f64: F₀ from the start, columns from rest; positions relative to
+    // the start's (exact differences, so the f64s keep their precision for the move).
     let mut st = AffineState {
-        x: Affine::constant(start.x as f64),
-        v: Affine::constant(start.v as f64),
-        a: Affine::constant(start.a as f64),
-        j: Affine::constant(start.j as f64),
+        x: Affine::constant(0.0),
+        v: Affine::constant(to_f64(start.v)),
+        a: Affine::constant(to_f64(start.a)),
+        j: Affine::constant(to_f64(start.j)),
     };
-    let mut piece_end_a = Vec::with_capacity(p.pieces.len());
-    let mut piece_end_v = Vec::with_capacity(p.pieces.len());
-    // Map jerk pieces back to problem pieces: order 2 emits one or two per piece.
+    let aim_x = to_f64(aim.x.checked_sub(start.x).ok_or(ExactFailure::Overflow)?);
+    let mut end_a = [Affine::default(); MAX_PIECES];
+    let mut end_v = [Affine::default(); MAX_PIECES];
     let mut k = 0;
-    for d in &p.pieces {
-        let parts = if p.order == 2 && d.ticks > 1 { 2 } else { 1 };
-        for _ in 0..parts {
-            let (ticks, level, _) = &pieces[k];
-            st = st.jerk_piece(level, *ticks);
+    for q in jerk_pieces(p, start) {
+        st.jerk_piece(&q.level.affine(), q.ticks);
+        if q.ends_piece {
+            end_a[k] = st.a;
+            end_v[k] = st.v;
             k += 1;
         }
-        piece_end_a.push(st.a);
-        piece_end_v.push(st.v);
     }
     let row = |c: &Condition| -> Affine {
         match *c {
-            Condition::A(i) => piece_end_a[i],
+            Condition::A(i) => end_a[i],
             Condition::V => st.v,
             Condition::X => st.x,
         }
     };
     let mut m = [[0.0; MAX_FREE]; MAX_FREE];
-    for (i, c) in p.conditions.iter().enumerate() {
-        m[i][..n].copy_from_slice(&row(c).k[..n]);
-    }
+    let mut r = [0.0; MAX_FREE];
     // The real levels: the continuous guess corrected so that the conditions hold.
     let mut levels = p.guess;
-    let mut r = [0.0; MAX_FREE];
     for (i, c) in p.conditions.iter().enumerate() {
         let f = row(c);
-        let val = f.c
-            + f.k[..n]
-                .iter()
-                .zip(&levels[..n])
-                .map(|(k, l)| k * l)
-                .sum::<f64>();
+        m[i][..n].copy_from_slice(&f.k()[..n]);
+        let val = f.at(&levels);
         r[i] = match *c {
             Condition::A(_) => -val,
-            Condition::V => aim.v as f64 - val,
-            Condition::X => aim.x - val,
+            Condition::V => to_f64(aim.v) - val,
+            Condition::X => aim_x - val,
         };
     }
-    let mut mm = m;
-    solve(&mut mm, &mut r, n).ok_or(ExactFailure::Singular)?;
+    let lu = Lu::new(&m, n).ok_or(ExactFailure::Singular)?;
+    let d = lu.solve(&r).ok_or(ExactFailure::Singular)?;
     for q in 0..n {
-        levels[q] += r[q];
+        levels[q] += d[q];
     }
-    let value = |f: &Affine| {
-        f.c + f.k[..n]
-            .iter()
-            .zip(&levels[..n])
-            .map(|(k, l)| k * l)
-            .sum::<f64>()
-    };
-    let cruise_v = p.cruise.map(|c| value(&piece_end_v[c]));
+    let cruise_v = p.cruise.map(|c| end_v[c].at(&levels));
     let mut piece_a = [0.0; MAX_PIECES];
-    for (out, a) in piece_a.iter_mut().zip(&piece_end_a) {
-        *out = value(a);
+    for (out, a) in piece_a.iter_mut().zip(&end_a[..p.pieces.len()]) {
+        *out = a.at(&levels);
     }
     Ok(Linear {
-        m,
+        lu,
         levels,
         cruise_v,
         piece_a,
@@ -477,26 +719,31 @@ pub fn realise(
     out: &mut Program,
 ) -> Result<ChainState, ExactFailure> {
     let n = p.free;
-    let aim = aim(p);
-    let (m, levels) = (lin.m, lin.levels);
+    let aim = aim(p)?;
+    let jp = jerk_pieces(p, start);
     let mut r = [0.0; MAX_FREE];
-    // 3. Integers, played exactly; one refinement on the exact residual.
-    let mut caps_of = Vec::with_capacity(24);
-    let mut ends = Vec::with_capacity(p.pieces.len());
-    let mut lv = round_levels(&levels, n).ok_or(ExactFailure::Overflow)?;
+    let (mut ends, mut at) = (ArrayVec::new(), ArrayVec::new());
+    // 3. Integers, played exactly; two refinements on the exact residual.
+    let mut lv = round_levels(&lin.levels, n).ok_or(ExactFailure::Overflow)?;
+    piece_ends(jp.clone(), start, &lv, &mut ends, &mut at)?;
     for _ in 0..2 {
-        integer_program(p, start, &lv, out, &mut caps_of, &mut ends)?;
-        residual(p, &aim, &ends, &mut r);
-        let mut mm = m;
-        solve(&mut mm, &mut r, n).ok_or(ExactFailure::Singular)?;
+        residual(p, &aim, &ends, &at, &mut r);
+        let d = lin.lu.solve(&r).ok_or(ExactFailure::Singular)?;
         // The correction is small: rounded on its own and added in integers, so the levels
         // keep every bit (an f64 level above 2^53 would not).
-        let d = round_levels(&r, n).ok_or(ExactFailure::Overflow)?;
+        let d = round_levels(&d, n).ok_or(ExactFailure::Overflow)?;
+        if d == [0; MAX_FREE] {
+            break;
+        }
         for q in 0..n {
             lv[q] = lv[q].checked_add(d[q]).ok_or(ExactFailure::Overflow)?;
         }
+        piece_ends(jp.clone(), start, &lv, &mut ends, &mut at)?;
     }
-    integer_program(p, start, &lv, out, &mut caps_of, &mut ends)?;
+    let checked = check_pieces(jp.clone(), start, &lv, &ends, caps);
+    #[cfg(test)]
+    tests::cross_check(jp.clone(), start, &lv, caps, checked);
+    checked?;
     // 4. The tail.
     let e = ends[ends.len() - 1];
     let ov = ExactFailure::Overflow;
@@ -516,11 +763,13 @@ pub fn realise(
         .ok_or(ov)?;
     let mut fin = e;
     for s in [s1, s2, s3] {
-        fin = fin.checked_advance(s, 1).ok_or(ov)?;
-        out.segments.push(Segment { ticks: 1, snap: s });
-        caps_of.push(2);
+        fin = one_tick(&fin, s).ok_or(ov)?;
+        check_ticks(caps, 2, &fin, &fin)?;
     }
-    check_limits(out, start, caps, &caps_of)?;
+    write_program(jp, start, &lv, out)?;
+    for s in [s1, s2, s3] {
+        out.segments.push(Segment { ticks: 1, snap: s });
+    }
     Ok(fin)
 }
 
@@ -536,48 +785,75 @@ pub fn check_limits(
     caps: &Caps,
     caps_of: &[usize],
 ) -> Result<(), ExactFailure> {
+    let ov = ExactFailure::Overflow;
     let mut s = *start;
     for (seg, &cap) in program.segments.iter().zip(caps_of) {
         let n = u64::from(seg.ticks);
-        let at = |k: u64| s.checked_advance(seg.snap, k).ok_or(ExactFailure::Overflow);
-        if seg.snap != 0 && n > 1 {
-            for k in 1..=n {
-                let t = at(k)?;
+        if n == 0 {
+            continue;
+        }
+        let first = one_tick(&s, seg.snap).ok_or(ov)?;
+        if n == 1 {
+            check_ticks(caps, cap, &first, &first)?;
+            s = first;
+            continue;
+        }
+        if seg.snap != 0 {
+            let mut t = first;
+            check_ticks(caps, cap, &t, &t)?;
+            for _ in 1..n {
+                t = one_tick(&t, seg.snap).ok_or(ov)?;
                 check_ticks(caps, cap, &t, &t)?;
             }
-        } else {
-            let (first, end) = (at(1)?, at(n)?);
-            if first.a.signum() * end.a.signum() < 0 {
-                // Zero snap after the first tick: a(k) = first.a + (k − 1)·first.j. The last
-                // tick on the first one's side of zero, estimated and then made exact.
-                let a = |k: u64| {
-                    i128::from(k - 1)
-                        .checked_mul(first.j)
-                        .and_then(|x| x.checked_add(first.a))
-                        .ok_or(ExactFailure::Overflow)
-                };
-                let side = first.a.signum();
-                let est = (-(first.a as f64) / first.j as f64).floor() + 1.0;
-                let mut k = if est.is_finite() {
-                    (est.max(1.0) as u64).min(n)
-                } else {
-                    1
-                };
-                while k > 1 && a(k)?.signum() == -side {
-                    k -= 1;
-                }
-                while k < n && a(k + 1)?.signum() != -side {
-                    k += 1;
-                }
-                check_ticks(caps, cap, &first, &at(k)?)?;
-                check_ticks(caps, cap, &at(k + 1)?, &end)?;
-            } else {
-                check_ticks(caps, cap, &first, &end)?;
-            }
+            s = t;
+            continue;
         }
-        s = at(n)?;
+        let end = zero_snap(&s, n).ok_or(ov)?;
+        check_run(caps, cap, &s, &end, n)?;
+        s = end;
     }
     Ok(())
+}
+
+/// Checks the `n` ticks of one zero-snap segment played from `s` and ending in `end`: split
+/// where the acceleration changes sign (it is linear in the tick), each part has its
+/// extremes at its ends.
+fn check_run(
+    caps: &Caps,
+    cap: usize,
+    s: &ChainState,
+    end: &ChainState,
+    n: u64,
+) -> Result<(), ExactFailure> {
+    let ov = ExactFailure::Overflow;
+    let first = one_tick(s, 0).ok_or(ov)?;
+    if first.a.signum() * end.a.signum() >= 0 {
+        return check_ticks(caps, cap, &first, end);
+    }
+    // The state k ticks in is `first` advanced k − 1; a(k) = first.a + (k − 1)·first.j. The
+    // last tick on the first one's side of zero, estimated and then made exact.
+    let at = |k: u64| zero_snap(&first, k - 1).ok_or(ov);
+    let a = |k: u64| {
+        i128::from(k - 1)
+            .checked_mul(first.j)
+            .and_then(|x| x.checked_add(first.a))
+            .ok_or(ov)
+    };
+    let side = first.a.signum();
+    let est = (-(first.a as f64) / first.j as f64).floor() + 1.0;
+    let mut k = if est.is_finite() {
+        (est.max(1.0) as u64).min(n)
+    } else {
+        1
+    };
+    while k > 1 && a(k)?.signum() == -side {
+        k -= 1;
+    }
+    while k < n && a(k + 1)?.signum() != -side {
+        k += 1;
+    }
+    check_ticks(caps, cap, &first, &at(k)?)?;
+    check_ticks(caps, cap, &at(k + 1)?, end)
 }
 
 /// Checks the ticks from `p` to `q` of one segment, across which the acceleration keeps its
@@ -598,5 +874,69 @@ fn check_ticks(
         Err(ExactFailure::Limit)
     } else {
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit tests of the planner call this from [`realise`]: the piece-level check must judge
+    /// the jerk pieces exactly as the segment-level [`check_limits`] judges the program they
+    /// write.
+    pub(super) fn cross_check(
+        jp: JerkPieces,
+        start: &ChainState,
+        lv: &[i128; MAX_FREE],
+        caps: &Caps,
+        pieces: Result<(), ExactFailure>,
+    ) {
+        let mut program = Program::empty();
+        write_program(jp.clone(), start, lv, &mut program).expect("the levels were played");
+        let mut caps_of = Vec::new();
+        for q in jp {
+            caps_of.push(q.cap);
+            let mut left = q.ticks - 1;
+            while left > 0 {
+                caps_of.push(q.cap);
+                left -= left.min(u64::from(u32::MAX));
+            }
+        }
+        assert_eq!(caps_of.len(), program.segments.len());
+        let segments = check_limits(&program, start, caps, &caps_of);
+        assert_eq!(
+            pieces.is_ok(),
+            segments.is_ok(),
+            "{program:?} from {start:?}"
+        );
+    }
+
+    /// The closed form of a piece equals the chain stepped tick by tick.
+    #[test]
+    fn a_piece_in_closed_form_is_the_chain_stepped() {
+        let w = crate::format::Widths {
+            x: 127,
+            v: 127,
+            a: 127,
+            j: 127,
+            d: 127,
+        };
+        let start = ChainState {
+            x: 123_456_789,
+            v: -98_765,
+            a: 4_321,
+            j: -17,
+        };
+        for (level, n) in [(5i128, 1u64), (-3, 2), (11, 3), (-7, 40), (0, 17)] {
+            let mut s = start.step(level - start.j, &w);
+            for _ in 1..n {
+                s = s.step(0, &w);
+            }
+            assert_eq!(
+                piece_end(&start, level, n),
+                Some(s),
+                "level {level}, {n} ticks"
+            );
+        }
     }
 }

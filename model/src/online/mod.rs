@@ -21,7 +21,8 @@ use crate::chain::ChainState;
 use crate::format::{Format, Quantity, FRAC_BITS};
 use crate::program::Program;
 
-use exact::{Caps, Condition, DPiece, ExactFailure, Problem, MAX_FREE};
+use arrayvec::ArrayVec;
+use exact::{Caps, Condition, DPiece, ExactFailure, Problem, MAX_FREE, MAX_PIECES};
 use position::{Branch, PositionProfile};
 use transition::{Entry, Shape, TickLimits, Transition};
 
@@ -203,7 +204,7 @@ fn ticks(t: f64, min: u64) -> u64 {
 /// Appends the discrete pieces of a transition: jerk pieces free (order 3), the hold fixed at
 /// zero jerk; order 2: its acceleration piece free.
 fn push_transition(
-    pieces: &mut Vec<DPiece>,
+    pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
     guess: &mut [f64; MAX_FREE],
     free: &mut usize,
     t: &Transition,
@@ -500,8 +501,8 @@ fn build(
     };
     let mut guess = [0.0; MAX_FREE];
     let mut free = 0;
-    let mut pieces = Vec::with_capacity(12);
-    let mut conditions = Vec::with_capacity(4);
+    let mut pieces = ArrayVec::new();
+    let mut conditions = ArrayVec::new();
     let mut cruise = None;
     let (cases, continuous, x_centre, rise, caps) = match *target {
         OnlineTarget::Velocity(_) => {
@@ -518,7 +519,7 @@ fn build(
                     branch: None,
                 },
                 t.duration(),
-                0.0,
+                0,
                 t.rise,
                 caps,
             )
@@ -562,7 +563,7 @@ fn build(
                     branch: Some(prof.branch),
                 },
                 prof.duration(),
-                centre as f64,
+                centre,
                 prof.second.rise,
                 caps,
             )
@@ -642,4 +643,63 @@ fn finish(
         continuous_ticks: continuous,
         cases,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Plans from seeded random states (the realisation cross-checks its piece-level limit
+    /// check with the segment-level one on every plan, `exact::tests::cross_check`).
+    #[test]
+    fn the_piece_level_check_agrees_with_the_segment_level_one() {
+        let f = Format::default();
+        // A small deterministic generator (no dependency): xorshift64*.
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut unit = move || {
+            state ^= state >> 12;
+            state ^= state << 25;
+            state ^= state >> 27;
+            (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut made = 0;
+        for i in 0..3000 {
+            let lu = |u: f64, lo: f64, hi: f64| lo * (hi / lo).powf(u);
+            let l = OnlineLimits {
+                velocity: lu(unit(), 0.01, 1.0),
+                acceleration: lu(unit(), 0.1, 10.0),
+                deceleration: lu(unit(), 0.1, 10.0),
+                jerk: lu(unit(), 1.0, 1000.0),
+            };
+            let order = if i % 3 == 2 {
+                OnlineOrder::Two
+            } else {
+                OnlineOrder::Three
+            };
+            let scale = |q| f.scale(q);
+            let start = ChainState {
+                x: f.home_raw(),
+                v: ((unit() * 2.0 - 1.0) * l.velocity * scale(Quantity::Velocity)) as i128,
+                a: if order == OnlineOrder::Two {
+                    0
+                } else {
+                    ((unit() * 1.8 - 0.9)
+                        * l.acceleration.min(l.deceleration)
+                        * scale(Quantity::Acceleration)) as i128
+                },
+                j: 0,
+            };
+            let cell = ((unit() * 2.0 - 1.0) * 3e5) as i128;
+            let target = if i % 4 == 0 {
+                OnlineTarget::Velocity((unit() * 2.0 - 1.0) * l.velocity)
+            } else {
+                OnlineTarget::Position {
+                    cell,
+                    velocity: 0.0,
+                }
+            };
+            made += usize::from(plan_online(&start, &target, &l, order, &f).is_ok());
+        }
+        assert!(made > 2900, "{made} of 3000 planned");
+    }
 }

@@ -84,23 +84,92 @@ impl Ctx<'_> {
         self.through(vc).0
     }
 
-    /// Bisection for `D(v) = x` on `[lo, hi]` with `D(lo) ≤ x ≤ D(hi)`, down to the
-    /// resolution of an f64 speed.
-    fn bisect(&self, x: f64, lo: f64, hi: f64) -> f64 {
-        let (mut lo, mut hi) = (lo, hi);
-        for _ in 0..64 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            if self.d(mid) <= x {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        0.5 * (lo + hi)
+    /// The `v` in `[lo, hi]` with `D(v) = x`, given `d_lo = D(lo) ≤ x ≤ D(hi) = d_hi`.
+    fn solve(&self, x: f64, (lo, d_lo): (f64, f64), (hi, d_hi): (f64, f64)) -> f64 {
+        // D(lo + u²) is nearly polynomial in u near lo, where the first transition's duration
+        // grows with √(v − v_i): the interpolations converge fast on it.
+        let u = root(
+            |u| self.d(lo + u * u) - x,
+            0.0,
+            d_lo - x,
+            (hi - lo).sqrt(),
+            d_hi - x,
+            1e-12 * x.abs(),
+        );
+        (lo + u * u).min(hi)
     }
+}
+
+/// A root of `f` between `a` and `b`, whose values `fa`, `fb` have opposite signs (or one is
+/// zero): a point where `|f| ≤ tol`, or the bracket at the resolution of an f64. Brent's
+/// method (inverse quadratic interpolation, secant, bisection when they would not shrink the
+/// bracket fast enough): superlinear on a smooth `f`, never slower than about twice a
+/// bisection. Pure IEEE-754 arithmetic: every platform finds the same root.
+pub fn root(f: impl Fn(f64) -> f64, a: f64, fa: f64, b: f64, fb: f64, tol: f64) -> f64 {
+    let (mut a, mut fa, mut b, mut fb) = (a, fa, b, fb);
+    if fa.abs() <= tol {
+        return a;
+    }
+    if fb.abs() <= tol {
+        return b;
+    }
+    if fa.abs() < fb.abs() {
+        std::mem::swap(&mut a, &mut b);
+        std::mem::swap(&mut fa, &mut fb);
+    }
+    // `b` the best estimate, `a` the other end of the bracket, `c` the previous `b`.
+    let (mut c, mut fc) = (a, fa);
+    let mut d = c;
+    let mut bisected = true;
+    for _ in 0..200 {
+        let close = 2.0 * f64::EPSILON * b.abs().max(a.abs());
+        if (b - a).abs() <= close {
+            break;
+        }
+        let mut s = if fa != fc && fb != fc {
+            // Inverse quadratic interpolation.
+            a * fb * fc / ((fa - fb) * (fa - fc))
+                + b * fa * fc / ((fb - fa) * (fb - fc))
+                + c * fa * fb / ((fc - fa) * (fc - fb))
+        } else {
+            // Secant.
+            b - fb * (b - a) / (fb - fa)
+        };
+        let q = (3.0 * a + b) / 4.0;
+        let between = if q < b {
+            s > q && s < b
+        } else {
+            s > b && s < q
+        };
+        let slow = if bisected {
+            (s - b).abs() >= (b - c).abs() / 2.0 || (b - c).abs() < close
+        } else {
+            (s - b).abs() >= (c - d).abs() / 2.0 || (c - d).abs() < close
+        };
+        bisected = !between || slow || !s.is_finite();
+        if bisected {
+            s = 0.5 * (a + b);
+        }
+        let fs = f(s);
+        if fs.abs() <= tol {
+            return s;
+        }
+        d = c;
+        c = b;
+        fc = fb;
+        if (fa < 0.0) == (fs < 0.0) {
+            a = s;
+            fa = fs;
+        } else {
+            b = s;
+            fb = fs;
+        }
+        if fa.abs() < fb.abs() {
+            std::mem::swap(&mut a, &mut b);
+            std::mem::swap(&mut fa, &mut fb);
+        }
+    }
+    b
 }
 
 /// Plans the move over distance `x` (from the current position) from `(v0, a0)` to end speed
@@ -158,8 +227,13 @@ pub fn plan(
         return Some(profile(Branch::Cruise, vmax, (x - d_max) / vmax));
     }
     let lo = c.v_end.max(vi.min(vmax));
-    if c.d(lo) <= x {
-        return Some(profile(Branch::Peak, c.bisect(x, lo, vmax), 0.0));
+    let d_lo = c.d(lo);
+    if d_lo <= x {
+        return Some(profile(
+            Branch::Peak,
+            c.solve(x, (lo, d_lo), (vmax, d_max)),
+            0.0,
+        ));
     }
     // Between the straight brake to the end speed and the peak branch: brake to the end speed
     // and cruise at it. (A profile that eases between two brakes would be faster, but where
