@@ -247,6 +247,17 @@ pub struct Linear {
     pub piece_a: [f64; MAX_PIECES],
 }
 
+impl Linear {
+    /// How the real levels move with the position the end must reach (`∂p/∂x`, raw level per
+    /// raw position), for a position target; `None` for another.
+    pub fn position_sensitivity(&self, p: &Problem) -> Option<[f64; MAX_FREE]> {
+        let row = p.conditions.iter().position(|c| *c == Condition::X)?;
+        let mut unit = [0.0; MAX_FREE];
+        unit[row] = 1.0;
+        self.lu.solve(&unit)
+    }
+}
+
 /// Exact caps on the registers (raw magnitudes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Caps {

@@ -11,7 +11,10 @@
 //! Order 4 online is not built; [`OnlineOrder`] is where it will go.
 
 pub mod exact;
+mod fallback;
+mod fit;
 pub mod position;
+mod problem;
 pub mod transition;
 
 use serde::Serialize;
@@ -21,10 +24,10 @@ use crate::chain::ChainState;
 use crate::format::{Format, Quantity, FRAC_BITS};
 use crate::program::Program;
 
-use arrayvec::ArrayVec;
-use exact::{Caps, Condition, DPiece, ExactFailure, Problem, MAX_FREE, MAX_PIECES};
-use position::{Branch, PositionProfile};
-use transition::{Entry, Shape, TickLimits, Transition};
+use exact::{Caps, ExactFailure};
+use position::Branch;
+use problem::{build, Built, Rounding, Setup};
+use transition::{Entry, Shape, TickLimits};
 
 /// Profile order of an online plan.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -149,6 +152,7 @@ impl OnlinePlan {
 }
 
 /// Raw integer limits and their real forms.
+#[derive(Clone, Copy, Debug)]
 struct RawLimits {
     v: i128,
     acc: i128,
@@ -195,50 +199,14 @@ fn raw_limits(
     })
 }
 
-/// Ticks of a piece: `t` rounded up (1e-6-tick tolerance, as the other planners), at least
-/// `min`.
-fn ticks(t: f64, min: u64) -> u64 {
-    (crate::planner::ceil_ticks(t)).max(min)
-}
-
-/// Appends the discrete pieces of a transition: jerk pieces free (order 3), the hold fixed at
-/// zero jerk; order 2: its acceleration piece free.
-fn push_transition(
-    pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
-    guess: &mut [f64; MAX_FREE],
-    free: &mut usize,
-    t: &Transition,
-    order: u8,
-    cap: usize,
-) {
-    for (i, p) in t.pieces().iter().enumerate() {
-        let is_hold = order == 3 && i == 1;
-        if is_hold {
-            let n = ticks(p.t, 0);
-            if n > 0 {
-                pieces.push(DPiece {
-                    ticks: n,
-                    free: None,
-                    cap,
-                    slack: true,
-                });
-            }
-        } else {
-            guess[*free] = p.level;
-            pieces.push(DPiece {
-                ticks: ticks(p.t, 1),
-                free: Some(*free),
-                cap,
-                slack: false,
-            });
-            *free += 1;
-        }
-    }
-}
-
 /// Plans from `start` to `target` (module documentation). The result is exact: the final
 /// state is `(target velocity, 0, 0)` bit for bit, a position target's output cell is the
 /// target cell, and from a state within the limits no limit is exceeded on any tick.
+///
+/// The plan is the time-optimal profile's, realised on whole ticks ([`exact`]); where that
+/// cannot be made exact within the limits (a refusal, rare: docs/MODEL.md §11), a target at
+/// rest or a velocity is reached by braking to rest exactly and moving on from there
+/// ([`fallback`]; [`Branch::Stop`]). Only a blend point is then refused.
 pub fn plan_online(
     start: &ChainState,
     target: &OnlineTarget,
@@ -246,6 +214,29 @@ pub fn plan_online(
     order: OnlineOrder,
     format: &Format,
 ) -> Result<OnlinePlan, OnlineError> {
+    let setup = setup(start, target, limits, order, format)?;
+    match attempts(&setup, format) {
+        Err(OnlineError::NotRealisable(why)) => {
+            fallback::stop_and_go(&setup, limits, order, format)
+                .map_err(|e| match e {
+                    OnlineError::NotRealisable(_) => OnlineError::NotRealisable(why),
+                    e => e,
+                })
+        }
+        r => r,
+    }
+}
+
+/// Checks the request and prepares what every attempt shares: the raw limits, the end
+/// velocity, the caps (the limits, or a start's inevitable excursion beyond them) and, for a
+/// position target, the goal and the direction.
+fn setup<'a>(
+    start: &'a ChainState,
+    target: &OnlineTarget,
+    limits: &OnlineLimits,
+    order: OnlineOrder,
+    format: &Format,
+) -> Result<Setup<'a>, OnlineError> {
     let lim = raw_limits(limits, order, format)?;
     let o = order.number();
     let v_target = match *target {
@@ -259,8 +250,10 @@ pub fn plan_online(
         });
     }
     let v_end = v_raw_f as i128;
-    let (v0, a0) = (start.v as f64, if o == 2 { 0.0 } else { start.a as f64 });
-    // Caps: the limits, or the start's inevitable excursion beyond them.
+    let (v0, a0) = (
+        exact::to_f64(start.v),
+        if o == 2 { 0.0 } else { exact::to_f64(start.a) },
+    );
     let vi = if o == 2 {
         v0
     } else {
@@ -282,7 +275,7 @@ pub fn plan_online(
         dec: lim.dec,
         entry: 0,
         a: [
-            0, // filled per transition below
+            0, // filled per transition
             0,
             lim.acc.max(lim.dec).max(a_entry),
         ],
@@ -301,16 +294,49 @@ pub fn plan_online(
     {
         caps.entry = a_entry;
     }
+    let goal = match *target {
+        OnlineTarget::Velocity(_) => None,
+        OnlineTarget::Position { cell, .. } => {
+            let centre = cell
+                .checked_shl(FRAC_BITS)
+                .and_then(|c| c.checked_add(format.half_lsb_raw()))
+                .filter(|c| (*c >> FRAC_BITS) == cell)
+                .ok_or(OnlineError::Overflow)?;
+            // The tail moves the position by 3·v_end (exact::realise).
+            let aim = v_end
+                .checked_mul(3)
+                .and_then(|t| centre.checked_sub(t))
+                .ok_or(OnlineError::Overflow)?;
+            let dist = exact::to_f64(aim.checked_sub(start.x).ok_or(OnlineError::Overflow)?);
+            let dir = position::direction(o, v0, a0, dist, v_end as f64, &lim.tick);
+            Some((centre, dist, dir))
+        }
+    };
+    Ok(Setup {
+        start,
+        target: *target,
+        o,
+        lim,
+        v_end,
+        a_entry,
+        caps,
+        goal,
+    })
+}
+
+/// The attempts of one plan (the ladder [`ATTEMPTS`]), the first exact one.
+fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
+    let (start, lim) = (setup.start, &setup.lim);
     let mut program = Program::empty();
     // Rounding up leaves no slack when a piece lasts a whole number of ticks, and the
     // discrete chain (a rectangle rule) can then ask a level a few parts in 10⁵ above its
     // limit; the exact position moves the cruise speed by what the rounding of every piece
-    // added. Each (scale, extra ticks) pair plans with limits lowered by the scale and every
-    // piece but the settle lengthened; `fit` then gives more ticks to a piece whose level is
-    // over its limit, and a cruise over the velocity limit lowers the planning velocity.
-    // The checks use the true limits throughout.
+    // added. Each attempt plans with limits lowered by its scale, every piece but the settle
+    // lengthened by its extra ticks and its pieces rounded its way; `fit` then gives more
+    // ticks to a piece whose level is over its limit, and a cruise over the velocity limit
+    // lowers the planning velocity. The checks use the true limits throughout.
     let mut last = ExactFailure::Limit;
-    for (scale, extra) in PLANNING_SCALES {
+    for (scale, extra, rounding) in ATTEMPTS {
         let mut tick = TickLimits {
             v: lim.tick.v * scale,
             acc: lim.tick.acc * scale,
@@ -318,13 +344,25 @@ pub fn plan_online(
             j: lim.tick.j * scale,
         };
         for retarget in 0..=RETARGETS {
-            let (mut problem, caps, cases, continuous) = build(
-                start, target, o, &lim, &tick, v_end, a_entry, caps, extra, format,
-            )?;
-            let lin = match fit(&mut problem, start, &caps) {
+            let Some(Built {
+                mut problem,
+                caps,
+                cases,
+                continuous,
+            }) = build(setup, &tick, extra, rounding)?
+            else {
+                // No profile in this direction with these planning limits.
+                if setup.v_end != 0 && scale == 1.0 {
+                    return Err(OnlineError::BlendUnreachable);
+                }
+                break;
+            };
+            if std::env::var("DBG").is_ok() { eprintln!("attempt {scale} {extra} {rounding:?} rt {retarget}: {:?} cont {continuous} pieces {:?} guess {:?}", cases, problem.pieces.iter().map(|p| (p.ticks, p.free)).collect::<Vec<_>>(), problem.guess); }
+            let lin = match fit::fit(&mut problem, start, &caps) {
                 Ok(lin) => lin,
                 Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
                 Err(e) => {
+                    if std::env::var("DBG").is_ok() { eprintln!("  fit failed {e:?}"); }
                     last = e;
                     break;
                 }
@@ -338,9 +376,12 @@ pub fn plan_online(
                 }
             }
             match exact::realise(&problem, start, &caps, &lin, &mut program) {
-                Ok(fin) => return finish(start, target, format, program, fin, continuous, cases),
+                Ok(fin) => {
+                    return finish(start, &setup.target, format, program, fin, continuous, cases)
+                }
                 Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
                 Err(e) => {
+                    if std::env::var("DBG").is_ok() { eprintln!("  realise failed {e:?} levels {:?} pieces {:?}", lin.levels, problem.pieces.iter().map(|p| p.ticks).collect::<Vec<_>>()); }
                     last = e;
                     break;
                 }
@@ -350,263 +391,26 @@ pub fn plan_online(
     Err(map(last))
 }
 
-/// The (planning scale, extra ticks) pairs [`plan_online`] tries in order: the limits the
-/// continuous profile is planned with (a fraction of the true ones) and the ticks added to
-/// every piece but the settle.
-const PLANNING_SCALES: [(f64, u64); 10] = [
-    (1.0, 0),
-    (1.0, 1),
-    (1.0 - 1e-4, 0),
-    (1.0 - 1e-4, 1),
-    (1.0 - 1e-3, 0),
-    (1.0 - 1e-3, 2),
-    (0.99, 0),
-    (0.99, 4),
-    (0.95, 0),
-    (0.95, 8),
+/// The attempts [`plan_online`] makes in order: the limits the continuous profile is planned
+/// with (a fraction of the true ones), the ticks added to every piece but the settle, and how
+/// the pieces are rounded to ticks.
+const ATTEMPTS: [(f64, u64, Rounding); 11] = [
+    (1.0, 0, Rounding::Up),
+    (1.0, 0, Rounding::Nearest),
+    (1.0, 1, Rounding::Up),
+    (1.0 - 1e-4, 0, Rounding::Up),
+    (1.0 - 1e-4, 1, Rounding::Up),
+    (1.0 - 1e-3, 0, Rounding::Up),
+    (1.0 - 1e-3, 2, Rounding::Up),
+    (0.99, 0, Rounding::Up),
+    (0.99, 4, Rounding::Up),
+    (0.95, 0, Rounding::Up),
+    (0.95, 8, Rounding::Up),
 ];
 
 /// Plans per scale with a lowered planning velocity when the level solution cruises above the
 /// velocity limit.
 const RETARGETS: usize = 2;
-
-/// Rounds of [`fit`].
-const FIT_ROUNDS: usize = 8;
-
-/// Ticks [`fit`] may add to a plan beyond those it takes from holds and the cruise.
-const FIT_GROWTH: u64 = 24;
-
-/// Fits the tick counts to the levels (docs/MODEL.md §11, "Fitting the ticks to the levels"),
-/// on the real solution of the level equations:
-///
-/// * a free piece whose level exceeds its limit by a ratio `r` (order 3: the jerk; order 2:
-///   the acceleration) is lengthened by `n·(√r − 1) + 1` ticks (order 3: a jerk piece's
-///   velocity change grows with `n²`) or `n·(r − 1) + 1` (order 2);
-/// * a hold (order 3) whose acceleration exceeds its limit by `r` is lengthened by
-///   `(n + m)·(r − 1) + 1`, `m` the ticks of the jerk pieces beside it (its velocity change
-///   grows with `n + m`);
-///
-/// the ticks taken (a jerk piece) from the hold beside it, else from the cruise where there
-/// is one, and the levels solved again. Ticks nobody lends lengthen the plan, at most
-/// [`FIT_GROWTH`] in all. Returns the real solution of the last solve (the limits are checked
-/// on the integers afterwards).
-fn fit(p: &mut Problem, start: &ChainState, caps: &Caps) -> Result<exact::Linear, ExactFailure> {
-    let mut grown = 0u64;
-    let mut lin = exact::linearise(p, start)?;
-    for _ in 0..FIT_ROUNDS {
-        let mut changed = false;
-        for i in 0..p.pieces.len() {
-            let d = p.pieces[i];
-            let is_hold = |j: usize| {
-                j < p.pieces.len() && {
-                    let h = &p.pieces[j];
-                    h.slack && h.free.is_none() && h.cap == d.cap && Some(j) != p.cruise
-                }
-            };
-            let jerk_ticks = |j: usize| {
-                p.pieces
-                    .get(j)
-                    .filter(|q| q.free.is_some())
-                    .map_or(0, |q| q.ticks)
-            };
-            // The planned sign of a piece's level or acceleration: the guess of its level, or
-            // (a hold) of the jerk piece before it. The other sign gets the smaller limit.
-            let limit = |value: f64, planned: f64| {
-                if value.signum() != planned.signum() {
-                    caps.acc.min(caps.dec) as f64
-                } else {
-                    caps.a[d.cap] as f64
-                }
-            };
-            let grow = match d.free {
-                Some(k) => {
-                    let level = lin.levels[k];
-                    let ratio = if p.order == 3 {
-                        level.abs() / caps.j as f64
-                    } else {
-                        level.abs() / limit(level, p.guess[k])
-                    };
-                    if !ratio.is_finite() {
-                        return Err(ExactFailure::Overflow);
-                    }
-                    if ratio <= 1.0 - 1e-9 {
-                        continue;
-                    }
-                    let factor = if p.order == 3 { ratio.sqrt() } else { ratio };
-                    (d.ticks as f64 * (factor - 1.0)).ceil().min(1e12) as u64 + 1
-                }
-                None if p.order == 3 && is_hold(i) && i > 0 => {
-                    let a = lin.piece_a[i];
-                    let planned = p.pieces[i - 1].free.map_or(a, |k| p.guess[k]);
-                    let ratio = a.abs() / limit(a, planned);
-                    if !ratio.is_finite() {
-                        return Err(ExactFailure::Overflow);
-                    }
-                    if ratio <= 1.0 - 1e-9 {
-                        continue;
-                    }
-                    let span = d.ticks + jerk_ticks(i - 1) + jerk_ticks(i + 1);
-                    (span as f64 * (ratio - 1.0)).ceil().min(1e12) as u64 + 1
-                }
-                None => continue,
-            };
-            let hold_beside = [i + 1, i.wrapping_sub(1)].into_iter().find(|&j| is_hold(j));
-            p.pieces[i].ticks += grow;
-            let donor = if d.free.is_some() {
-                hold_beside.or(p.cruise)
-            } else {
-                p.cruise
-            };
-            let lent = donor.map_or(0, |j| {
-                let t = grow.min(p.pieces[j].ticks.saturating_sub(1));
-                p.pieces[j].ticks -= t;
-                t
-            });
-            grown += grow - lent;
-            if grown > FIT_GROWTH {
-                return Err(ExactFailure::Limit);
-            }
-            changed = true;
-        }
-        if !changed {
-            return Ok(lin);
-        }
-        lin = exact::linearise(p, start)?;
-    }
-    Ok(lin)
-}
-
-/// The discrete problem for planning limits `tick` (true limits in `lim`), every piece but
-/// the settle lengthened by `extra` ticks; with its caps, cases and continuous duration.
-#[allow(clippy::too_many_arguments)]
-fn build(
-    start: &ChainState,
-    target: &OnlineTarget,
-    o: u8,
-    lim: &RawLimits,
-    tick: &TickLimits,
-    v_end: i128,
-    a_entry: i128,
-    caps: Caps,
-    extra: u64,
-    format: &Format,
-) -> Result<(Problem, Caps, Cases, f64), OnlineError> {
-    let (v0, a0) = (start.v as f64, if o == 2 { 0.0 } else { start.a as f64 });
-    let raw_of = |a: f64| {
-        if a == tick.acc {
-            lim.acc
-        } else {
-            lim.dec
-        }
-    };
-    let mut guess = [0.0; MAX_FREE];
-    let mut free = 0;
-    let mut pieces = ArrayVec::new();
-    let mut conditions = ArrayVec::new();
-    let mut cruise = None;
-    let (cases, continuous, x_centre, rise, caps) = match *target {
-        OnlineTarget::Velocity(_) => {
-            let t = transition::velocity(o, v0, a0, v_end as f64, tick);
-            push_transition(&mut pieces, &mut guess, &mut free, &t, o, 0);
-            let caps = Caps {
-                a: [raw_of(t.accel_limit).max(a_entry), 0, caps.a[2]],
-                ..caps
-            };
-            (
-                Cases {
-                    first: (t.rise, t.entry, t.shape),
-                    second: None,
-                    branch: None,
-                },
-                t.duration(),
-                0,
-                t.rise,
-                caps,
-            )
-        }
-        OnlineTarget::Position { cell, .. } => {
-            let centre = cell
-                .checked_shl(FRAC_BITS)
-                .and_then(|c| c.checked_add(format.half_lsb_raw()))
-                .filter(|c| (*c >> FRAC_BITS) == cell)
-                .ok_or(OnlineError::Overflow)?;
-            let goal = centre
-                .checked_sub(v_end.checked_mul(3).ok_or(OnlineError::Overflow)?)
-                .ok_or(OnlineError::Overflow)?;
-            let dist = goal.checked_sub(start.x).ok_or(OnlineError::Overflow)? as f64;
-            let prof: PositionProfile = position::plan(o, v0, a0, dist, v_end as f64, tick)
-                .ok_or(OnlineError::BlendUnreachable)?;
-            push_transition(&mut pieces, &mut guess, &mut free, &prof.first, o, 0);
-            cruise = Some(pieces.len());
-            pieces.push(DPiece {
-                ticks: ticks(prof.cruise, 1),
-                free: None,
-                cap: 2,
-                slack: true,
-            });
-            if o == 3 {
-                conditions.push(Condition::A(pieces.len() - 1));
-            }
-            push_transition(&mut pieces, &mut guess, &mut free, &prof.second, o, 1);
-            let caps = Caps {
-                a: [
-                    raw_of(prof.first.accel_limit).max(a_entry),
-                    raw_of(prof.second.accel_limit),
-                    caps.a[2],
-                ],
-                ..caps
-            };
-            (
-                Cases {
-                    first: (prof.first.rise, prof.first.entry, prof.first.shape),
-                    second: Some((prof.second.rise, prof.second.entry, prof.second.shape)),
-                    branch: Some(prof.branch),
-                },
-                prof.duration(),
-                centre,
-                prof.second.rise,
-                caps,
-            )
-        }
-    };
-    // The settle piece: the highest derivative back to zero (order 2 needs two ticks: the
-    // acceleration step and the jerk back to zero).
-    pieces.push(DPiece {
-        ticks: if o == 2 { 2 } else { 1 },
-        free: None,
-        cap: 2,
-        slack: false,
-    });
-    if o == 3 {
-        conditions.push(Condition::A(pieces.len() - 1));
-    }
-    conditions.push(Condition::V);
-    if matches!(target, OnlineTarget::Position { .. }) {
-        conditions.push(Condition::X);
-    }
-    debug_assert_eq!(conditions.len(), free);
-    let settle = pieces.len() - 1;
-    for d in &mut pieces[..settle] {
-        d.ticks += extra;
-    }
-    // The tick counter and the closed form's binomials bound a piece (2^40 ticks is 127 days
-    // at 10 µs): longer is refused, never wrapped.
-    if pieces.iter().any(|d| d.ticks >= 1 << 40) {
-        return Err(OnlineError::Overflow);
-    }
-    let problem = Problem {
-        order: o,
-        pieces,
-        free,
-        conditions,
-        v_end,
-        approach: if rise { 1 } else { -1 },
-        x_centre,
-        guess,
-        cruise,
-    };
-    Ok((problem, caps, cases, continuous))
-}
 
 fn map(e: ExactFailure) -> OnlineError {
     match e {

@@ -1,31 +1,38 @@
-//! To a position from any state: a velocity transition to a cruise speed `v_c`, a cruise, and a
-//! transition from `v_c` to the end speed (zero for MC_MoveAbsolute, the blend speed when the
-//! move hands over to a tangent next move). In tick units, continuous time.
+//! To a position from any state, in tick units and continuous time: seed 002's motion
+//! planner ("determine if an increased speed can be reached in the time and distance
+//! available; if not, set a speed that can be attained"). Mirrored so that the axis moves in
+//! `+` toward the target (or in the direction of a non-zero end speed), let `v_i` be the speed
+//! at which the entry acceleration reaches zero at full jerk
+//! ([`super::transition::intermediate_speed`]), `v_e ≥ 0` the end speed, and `D(v_c)` the
+//! distance of a transition from the entry state to a speed `v_c` followed by one from `v_c` to
+//! `v_e` (no cruise). The branches, by the distance `X` to go:
 //!
-//! The distance covered without cruise, `D(v_c)`, is what decides `v_c` (seed 002's motion
-//! planner: "determine if an increased speed can be reached in the time and distance
-//! available; if not, set a speed that can be attained"). Let `v_i` be the speed at which the
-//! entry acceleration reaches zero at full jerk ([`super::transition::intermediate_speed`]) and
-//! `S = D(clamp(v_i))` the distance of braking at once. Mirrored so that the target lies ahead
-//! of the point where an immediate stop would end (or in the direction of a non-zero end
-//! speed):
+//! 1. [`Branch::Cruise`] — `D(v_max) ≤ X`: transition to the limit, cruise for
+//!    `(X − D(v_max))/v_max`, transition to `v_e`.
+//! 2. [`Branch::Peak`] — `D(max(v_i, v_e)) ≤ X < D(v_max)`: `D` grows with `v_c` there and the
+//!    `v_c` with `D(v_c) = X` is found by Brent's method; the speed peaks there (the seed's
+//!    "incrementally optimal" speed when the set speed cannot be reached in the remaining
+//!    distance).
+//! 3. [`Branch::Partial`] — the entry already brakes (`a₀ < 0`) and `X` lies between the
+//!    distance of braking on at once (`D(v_e)`) and `D(v_i)` (releasing the brake fully, then
+//!    braking again): the brake is released only partly — jerk `+J` for a time `t` that the
+//!    distance decides (found by Brent's method), then the fall to `v_e` from where that leaves
+//!    the acceleration. This is seed 002's *partial* transition (PARTIAL_CONCAVE_FALL: the
+//!    acceleration never reaches zero before the end).
+//! 4. [`Branch::Descend`] — an entry whose speed is or will be beyond the limit (`v_i > v_max`,
+//!    limits lowered mid-move) with `D(v_e) ≤ X < D(v_max)`: fall to the `v_c ≤ v_max` with
+//!    `D(v_c) = X`, then to `v_e`. (Such a start is only promised to come back within its
+//!    limits without undershoot or reversal.)
 //!
-//! 1. [`Branch::Cruise`] — `D(v_max) ≤ X`: cruise at the limit for `(X − D(v_max))/v_max`.
-//! 2. [`Branch::Peak`] — `D` grows with `v_c` above `max(v_i, v_end)`: the `v_c` with
-//!    `D(v_c) = X` is found by bisection; the speed peaks there (the seed's "incrementally
-//!    optimal" speed when the set speed cannot be reached in the remaining distance).
-//! 3. [`Branch::Ease`] — `D(v_end) ≤ X` but the peak branch does not fit (an entry above the
-//!    limits, or one already braking): brake to the end speed and cruise at it to the point.
-//!
-//! A target behind the stopping point (end speed zero) is the same problem mirrored: the
-//! direction is chosen first, so the axis reverses exactly when it must.
-//!
-//! A non-zero end speed whose blend point lies behind the point where that speed can be
-//! reached is refused ([`super::OnlineError::BlendUnreachable`]).
+//! Below `D(v_e)` no profile in this direction reaches `v_e` by the target: with `v_e = 0` the
+//! target lies behind the point where braking at once stops the axis, and the plan is the same
+//! problem mirrored — the direction is chosen first ([`direction`]), so the axis reverses
+//! exactly when it must; with `v_e ≠ 0` the blend point is refused
+//! ([`super::OnlineError::BlendUnreachable`]).
 
 use serde::Serialize;
 
-use super::transition::{intermediate_speed, velocity, TickLimits, Transition};
+use super::transition::{intermediate_speed, velocity, Piece, TickLimits, Transition};
 
 /// Which branch decided the cruise speed (module documentation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -35,29 +42,61 @@ pub enum Branch {
     Cruise,
     /// Peak speed below the limit, no cruise.
     Peak,
-    /// Brake to the end speed, cruise at it.
-    Ease,
+    /// A brake released in part, then the fall to the end speed.
+    Partial,
+    /// From beyond the limits, fall to a speed within them, then to the end speed.
+    Descend,
+    /// The fallback: brake to rest, then move on from rest (`super::fallback`).
+    Stop,
 }
 
 /// A planned position profile (continuous, tick units).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PositionProfile {
-    /// Branch.
-    pub branch: Branch,
-    /// Cruise speed (raw per tick).
-    pub vc: f64,
-    /// Transition from the entry state to `vc`.
-    pub first: Transition,
-    /// Cruise duration (ticks, real, ≥ 0).
-    pub cruise: f64,
-    /// Transition from `vc` to the end speed.
-    pub second: Transition,
+pub enum PositionProfile {
+    /// Transition to `vc`, cruise, transition to the end speed ([`Branch::Cruise`],
+    /// [`Branch::Peak`], [`Branch::Descend`]).
+    Through {
+        /// Branch.
+        branch: Branch,
+        /// Cruise speed (raw per tick).
+        vc: f64,
+        /// Transition from the entry state to `vc`.
+        first: Transition,
+        /// Cruise duration (ticks, real, ≥ 0).
+        cruise: f64,
+        /// Transition from `vc` to the end speed.
+        second: Transition,
+    },
+    /// [`Branch::Partial`]: the brake released in part (`release`: jerk held for its
+    /// duration), then the fall to the end speed.
+    Partial {
+        /// The release.
+        release: Piece,
+        /// The fall, from the state the release leaves.
+        fall: Transition,
+    },
 }
 
 impl PositionProfile {
     /// Total duration (ticks, real).
     pub fn duration(&self) -> f64 {
-        self.first.duration() + self.cruise + self.second.duration()
+        match self {
+            PositionProfile::Through {
+                first,
+                cruise,
+                second,
+                ..
+            } => first.duration() + cruise + second.duration(),
+            PositionProfile::Partial { release, fall } => release.t + fall.duration(),
+        }
+    }
+
+    /// The branch.
+    pub fn branch(&self) -> Branch {
+        match self {
+            PositionProfile::Through { branch, .. } => *branch,
+            PositionProfile::Partial { .. } => Branch::Partial,
+        }
     }
 }
 
@@ -82,6 +121,22 @@ impl Ctx<'_> {
     /// `D(vc)`.
     fn d(&self, vc: f64) -> f64 {
         self.through(vc).0
+    }
+
+    /// The partial release (order 3, `a₀ < 0`): jerk `+J` for `t`, then the fall to the end
+    /// speed; the distance it covers, the release and the fall.
+    fn partial(&self, t: f64) -> (f64, Piece, Transition) {
+        let j = self.lim.j;
+        let (v0, a0) = (self.v0, self.a0);
+        let a1 = a0 + j * t;
+        let v1 = v0 + a0 * t + j * t * t / 2.0;
+        let x1 = v0 * t + a0 * t * t / 2.0 + j * t * t * t / 6.0;
+        let fall = velocity(3, v1, a1, self.v_end, self.lim);
+        (
+            x1 + fall.distance(3, v1, a1),
+            Piece { t, level: j },
+            fall,
+        )
     }
 
     /// The `v` in `[lo, hi]` with `D(v) = x`, given `d_lo = D(lo) ≤ x ≤ D(hi) = d_hi`.
@@ -172,32 +227,36 @@ pub fn root(f: impl Fn(f64) -> f64, a: f64, fa: f64, b: f64, fb: f64, tol: f64) 
     b
 }
 
+/// The direction (`±1`) a move over distance `x` from `(v0, a0)` to end speed `v_end` goes:
+/// that of a non-zero end speed, else where the target lies from the point where braking at
+/// once stops the axis.
+pub fn direction(order: u8, v0: f64, a0: f64, x: f64, v_end: f64, lim: &TickLimits) -> f64 {
+    if v_end != 0.0 {
+        return v_end.signum();
+    }
+    let a0 = if order == 2 { 0.0 } else { a0 };
+    let stop = velocity(order, v0, a0, 0.0, lim).distance(order, v0, a0);
+    if x >= stop {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 /// Plans the move over distance `x` (from the current position) from `(v0, a0)` to end speed
-/// `v_end`; `None` when a non-zero end speed cannot be reached before the blend point.
+/// `v_end`, in direction `dir` ([`direction`]); `None` when no profile in that direction
+/// reaches `v_end` by the target.
 pub fn plan(
     order: u8,
     v0: f64,
     a0: f64,
     x: f64,
     v_end: f64,
+    dir: f64,
     lim: &TickLimits,
 ) -> Option<PositionProfile> {
     let a0 = if order == 2 { 0.0 } else { a0 };
-    let ahead = Ctx {
-        order,
-        v0,
-        a0,
-        v_end,
-        lim,
-    };
-    // Direction: that of a non-zero end speed, else where the target lies from the stop point.
-    let s = if v_end != 0.0 {
-        v_end.signum()
-    } else if x >= ahead.d(0.0) {
-        1.0
-    } else {
-        -1.0
-    };
+    let s = dir;
     let c = Ctx {
         order,
         v0: s * v0,
@@ -205,6 +264,9 @@ pub fn plan(
         v_end: s * v_end,
         lim,
     };
+    if c.v_end < 0.0 {
+        return None;
+    }
     let x = s * x;
     let vmax = lim.v;
     let vi = if order == 2 {
@@ -212,9 +274,17 @@ pub fn plan(
     } else {
         intermediate_speed(c.v0, c.a0, lim.j)
     };
-    let profile = |branch, vc: f64, cruise: f64| {
+    // Transitions planned from the true (unmirrored) state.
+    let ahead = Ctx {
+        order,
+        v0,
+        a0,
+        v_end,
+        lim,
+    };
+    let through = |branch, vc: f64, cruise: f64| {
         let (_, first, second) = ahead.through(s * vc);
-        PositionProfile {
+        PositionProfile::Through {
             branch,
             vc: s * vc,
             first,
@@ -224,30 +294,68 @@ pub fn plan(
     };
     let d_max = c.d(vmax);
     if d_max <= x {
-        return Some(profile(Branch::Cruise, vmax, (x - d_max) / vmax));
+        return Some(through(Branch::Cruise, vmax, (x - d_max) / vmax));
     }
+    let tol = 1e-12 * x.abs();
     let lo = c.v_end.max(vi.min(vmax));
     let d_lo = c.d(lo);
     if d_lo <= x {
-        return Some(profile(
+        return Some(through(
             Branch::Peak,
             c.solve(x, (lo, d_lo), (vmax, d_max)),
             0.0,
         ));
     }
-    // Between the straight brake to the end speed and the peak branch: brake to the end speed
-    // and cruise at it. (A profile that eases between two brakes would be faster, but where
-    // D(v) is flat in v its levels cannot absorb the rounding of its pieces to ticks; the
-    // cruise can.) With an end speed of zero the direction choice puts x at or beyond D(0);
-    // only rounding of the distances brings it here.
     let d_end = c.d(c.v_end);
-    if d_end <= x || c.v_end == 0.0 {
-        let cruise = if c.v_end > 0.0 {
-            ((x - d_end) / c.v_end).max(0.0)
-        } else {
-            0.0
-        };
-        return Some(profile(Branch::Ease, c.v_end, cruise));
+    if vi > vmax {
+        // From beyond the limits: fall to a speed within them.
+        if d_end > x {
+            return None;
+        }
+        let u = root(
+            |u| c.d(c.v_end + u * u) - x,
+            0.0,
+            d_end - x,
+            (vmax - c.v_end).max(0.0).sqrt(),
+            d_max - x,
+            tol,
+        );
+        let vc = (c.v_end + u * u).min(vmax);
+        return Some(through(Branch::Descend, vc, 0.0));
+    }
+    if order == 3 && c.a0 < 0.0 && vi > c.v_end {
+        // A brake released in part: t from 0 (brake on: D(v_e)) to |a₀|/J (released: D(v_i)).
+        if d_end > x {
+            return None;
+        }
+        let t_full = -c.a0 / lim.j;
+        let t = root(
+            |t| c.partial(t).0 - x,
+            0.0,
+            d_end - x,
+            t_full,
+            d_lo - x,
+            tol,
+        );
+        let (_, release, _) = c.partial(t);
+        // The fall from the state the release leaves, unmirrored.
+        let (v1, a1) = (
+            v0 + a0 * t + s * lim.j * t * t / 2.0,
+            a0 + s * lim.j * t,
+        );
+        let fall = velocity(3, v1, a1, v_end, lim);
+        return Some(PositionProfile::Partial {
+            release: Piece {
+                t: release.t,
+                level: s * release.level,
+            },
+            fall,
+        });
+    }
+    // Otherwise D(max(v_i, v_e)) is the distance of braking at once: only the rounding of
+    // the distances brings a target here, and the peak is at its lower end.
+    if x >= d_lo - 1e-9 * d_lo.abs() {
+        return Some(through(Branch::Peak, lo, 0.0));
     }
     None
 }

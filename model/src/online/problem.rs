@@ -1,0 +1,270 @@
+//! From a continuous profile ([`super::transition`], [`super::position`]) to the discrete
+//! problem [`super::exact`] solves: pieces of whole ticks, which of their levels are free, and
+//! the end conditions.
+
+use arrayvec::ArrayVec;
+
+use crate::chain::ChainState;
+
+use super::exact::{Caps, Condition, DPiece, Problem, MAX_FREE, MAX_PIECES};
+use super::position::{self, PositionProfile};
+use super::transition::{self, TickLimits, Transition};
+use super::{Cases, OnlineError, OnlineTarget, RawLimits};
+
+/// How a piece's real duration becomes whole ticks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Rounding {
+    /// Up (1e-6-tick tolerance, as the other planners): the levels can only come out lower.
+    Up,
+    /// To the nearest whole tick: what a plan from a state on one of the planner's own
+    /// trajectories usually needs to find that trajectory's own tick counts again.
+    Nearest,
+}
+
+impl Rounding {
+    /// Ticks of a piece of real duration `t`, at least `min`.
+    fn ticks(self, t: f64, min: u64) -> u64 {
+        let n = match self {
+            Rounding::Up => crate::planner::ceil_ticks(t),
+            Rounding::Nearest => {
+                let r = crate::planner::fmath::round(t);
+                if r.is_finite() && r > 0.0 {
+                    r.min((u64::MAX / 4) as f64) as u64
+                } else {
+                    0
+                }
+            }
+        };
+        n.max(min)
+    }
+}
+
+/// What every attempt at one plan shares.
+pub(super) struct Setup<'a> {
+    pub start: &'a ChainState,
+    pub target: OnlineTarget,
+    /// Order (3 or 2).
+    pub o: u8,
+    pub lim: RawLimits,
+    /// The end velocity (raw).
+    pub v_end: i128,
+    /// The start's acceleration magnitude over its first tick.
+    pub a_entry: i128,
+    pub caps: Caps,
+    /// Position targets: the centre of the target cell (raw), the distance to the goal the
+    /// program's main part aims at (raw, real), and the direction (`±1`, chosen once with the
+    /// true limits so that no attempt with lowered ones reverses where the first would not).
+    pub goal: Option<(i128, f64, f64)>,
+}
+
+/// A discrete problem with its caps, the seed 002 cases it went through and the continuous
+/// profile's duration.
+pub(super) struct Built {
+    pub problem: Problem,
+    pub caps: Caps,
+    pub cases: Cases,
+    pub continuous: f64,
+}
+
+/// Appends the discrete pieces of a transition: jerk pieces free (order 3), the hold fixed at
+/// zero jerk; order 2: its acceleration piece free.
+fn push_transition(
+    pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
+    guess: &mut [f64; MAX_FREE],
+    free: &mut usize,
+    t: &Transition,
+    order: u8,
+    cap: usize,
+    rounding: Rounding,
+) {
+    for (i, p) in t.pieces().iter().enumerate() {
+        let is_hold = order == 3 && i == 1;
+        if is_hold {
+            let n = rounding.ticks(p.t, 0);
+            if n > 0 {
+                pieces.push(DPiece {
+                    ticks: n,
+                    free: None,
+                    cap,
+                    slack: true,
+                });
+            }
+        } else {
+            guess[*free] = p.level;
+            pieces.push(DPiece {
+                ticks: rounding.ticks(p.t, 1),
+                free: Some(*free),
+                cap,
+                slack: false,
+            });
+            *free += 1;
+        }
+    }
+}
+
+/// The cases of a transition.
+fn cases_of(t: &Transition) -> (bool, transition::Entry, transition::Shape) {
+    (t.rise, t.entry, t.shape)
+}
+
+/// The discrete problem for planning limits `tick` (the true ones in `setup.lim`), every piece
+/// but the settle lengthened by `extra` ticks; `None` when no continuous profile in the plan's
+/// direction exists with these planning limits.
+pub(super) fn build(
+    setup: &Setup,
+    tick: &TickLimits,
+    extra: u64,
+    rounding: Rounding,
+) -> Result<Option<Built>, OnlineError> {
+    let (o, start, lim) = (setup.o, setup.start, &setup.lim);
+    let (v0, a0) = (
+        super::exact::to_f64(start.v),
+        if o == 2 {
+            0.0
+        } else {
+            super::exact::to_f64(start.a)
+        },
+    );
+    let raw_of = |a: f64| {
+        if a == tick.acc {
+            lim.acc
+        } else {
+            lim.dec
+        }
+    };
+    let mut guess = [0.0; MAX_FREE];
+    let mut free = 0;
+    let mut pieces = ArrayVec::new();
+    let mut conditions = ArrayVec::new();
+    let mut cruise = None;
+    let push = |pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
+                guess: &mut [f64; MAX_FREE],
+                free: &mut usize,
+                t: &Transition,
+                cap: usize| {
+        push_transition(pieces, guess, free, t, o, cap, rounding)
+    };
+    let (cases, continuous, x_centre, rise, caps) = match (setup.target, setup.goal) {
+        (OnlineTarget::Velocity(_), _) | (_, None) => {
+            let t = transition::velocity(o, v0, a0, setup.v_end as f64, tick);
+            push(&mut pieces, &mut guess, &mut free, &t, 0);
+            let caps = Caps {
+                a: [raw_of(t.accel_limit).max(setup.a_entry), 0, setup.caps.a[2]],
+                ..setup.caps
+            };
+            let cases = Cases {
+                first: cases_of(&t),
+                second: None,
+                branch: None,
+            };
+            (cases, t.duration(), 0, t.rise, caps)
+        }
+        (OnlineTarget::Position { .. }, Some((centre, dist, dir))) => {
+            let Some(prof) = position::plan(o, v0, a0, dist, setup.v_end as f64, dir, tick)
+            else {
+                return Ok(None);
+            };
+            match prof {
+                PositionProfile::Through {
+                    branch,
+                    first,
+                    cruise: c,
+                    second,
+                    ..
+                } => {
+                    push(&mut pieces, &mut guess, &mut free, &first, 0);
+                    cruise = Some(pieces.len());
+                    pieces.push(DPiece {
+                        ticks: rounding.ticks(c, 1),
+                        free: None,
+                        cap: 2,
+                        slack: true,
+                    });
+                    if o == 3 {
+                        conditions.push(Condition::A(pieces.len() - 1));
+                    }
+                    push(&mut pieces, &mut guess, &mut free, &second, 1);
+                    let caps = Caps {
+                        a: [
+                            raw_of(first.accel_limit).max(setup.a_entry),
+                            raw_of(second.accel_limit),
+                            setup.caps.a[2],
+                        ],
+                        ..setup.caps
+                    };
+                    let cases = Cases {
+                        first: cases_of(&first),
+                        second: Some(cases_of(&second)),
+                        branch: Some(branch),
+                    };
+                    (cases, prof.duration(), centre, second.rise, caps)
+                }
+                PositionProfile::Partial { release, fall } => {
+                    // The release: a free jerk piece before the fall.
+                    guess[free] = release.level;
+                    pieces.push(DPiece {
+                        ticks: rounding.ticks(release.t, 1),
+                        free: Some(free),
+                        cap: 0,
+                        slack: false,
+                    });
+                    free += 1;
+                    push(&mut pieces, &mut guess, &mut free, &fall, 0);
+                    let a_fall = raw_of(fall.accel_limit).max(setup.a_entry);
+                    let caps = Caps {
+                        a: [a_fall, a_fall, setup.caps.a[2]],
+                        ..setup.caps
+                    };
+                    let cases = Cases {
+                        first: cases_of(&fall),
+                        second: None,
+                        branch: Some(prof.branch()),
+                    };
+                    (cases, prof.duration(), centre, fall.rise, caps)
+                }
+            }
+        }
+    };
+    // The settle piece: the highest derivative back to zero (order 2 needs two ticks: the
+    // acceleration step and the jerk back to zero).
+    pieces.push(DPiece {
+        ticks: if o == 2 { 2 } else { 1 },
+        free: None,
+        cap: 2,
+        slack: false,
+    });
+    if o == 3 {
+        conditions.push(Condition::A(pieces.len() - 1));
+    }
+    conditions.push(Condition::V);
+    if setup.goal.is_some() {
+        conditions.push(Condition::X);
+    }
+    debug_assert_eq!(conditions.len(), free);
+    let settle = pieces.len() - 1;
+    for d in &mut pieces[..settle] {
+        d.ticks += extra;
+    }
+    // The tick counter and the closed form's binomials bound a piece (2^40 ticks is 127 days
+    // at 10 µs): longer is refused, never wrapped.
+    if pieces.iter().any(|d| d.ticks >= 1 << 40) {
+        return Err(OnlineError::Overflow);
+    }
+    let problem = Problem {
+        order: o,
+        pieces,
+        free,
+        conditions,
+        v_end: setup.v_end,
+        approach: if rise { 1 } else { -1 },
+        x_centre,
+        guess,
+        cruise,
+    };
+    Ok(Some(Built {
+        problem,
+        caps,
+        cases,
+        continuous,
+    }))
+}
