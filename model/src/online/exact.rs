@@ -245,6 +245,8 @@ pub struct Linear {
     pub cruise_v: Option<f64>,
     /// The acceleration at the end of each piece at these levels (raw per tick²).
     pub piece_a: [f64; MAX_PIECES],
+    /// The velocity at the end of each piece at these levels (raw per tick).
+    pub piece_v: [f64; MAX_PIECES],
 }
 
 impl Linear {
@@ -708,15 +710,17 @@ pub fn linearise(p: &Problem, start: &ChainState) -> Result<Linear, ExactFailure
         levels[q] += d[q];
     }
     let cruise_v = p.cruise.map(|c| end_v[c].at(&levels));
-    let mut piece_a = [0.0; MAX_PIECES];
-    for (out, a) in piece_a.iter_mut().zip(&end_a[..p.pieces.len()]) {
-        *out = a.at(&levels);
+    let (mut piece_a, mut piece_v) = ([0.0; MAX_PIECES], [0.0; MAX_PIECES]);
+    for i in 0..p.pieces.len() {
+        piece_a[i] = end_a[i].at(&levels);
+        piece_v[i] = end_v[i].at(&levels);
     }
     Ok(Linear {
         lu,
         levels,
         cruise_v,
         piece_a,
+        piece_v,
     })
 }
 

@@ -13,7 +13,7 @@ use arrayvec::ArrayVec;
 
 use crate::chain::ChainState;
 
-use super::exact::{linearise, Caps, ExactFailure, Linear, Problem};
+use super::exact::{linearise, to_f64, Caps, ExactFailure, Linear, Problem};
 
 /// Rounds of [`fit`].
 const FIT_ROUNDS: usize = 24;
@@ -151,9 +151,12 @@ fn jerk_ticks(p: &Problem, j: usize) -> u64 {
 /// solve turns a change `Δx` of where the ticks lead into a level change `−s·Δx`
 /// (`s = ∂p_k/∂x`, [`Linear::position_sensitivity`]). So the cruise gains or loses the fewest
 /// ticks that bring the level within its limit; where it cannot lose enough (a peak profile,
-/// whose cruise is one tick), the first transition is shortened ([`trim`]). Cruise ticks are
-/// added only when fewer than the `grow` the level's own piece would need. `None` when
-/// neither applies (the level then gets more ticks in [`fit`]); ticks added count in `grown`.
+/// whose cruise is one tick), the first transition is shortened ([`trim`]). A profile without
+/// a cruise (a partial release) takes the ticks from its longest piece, at that piece's
+/// speed: a tick there changes its transition's velocity by a part in its length, which the
+/// levels take up. Ticks are added only when fewer than the `grow` the level's own piece
+/// would need. `None` when nothing applies (the level then gets more ticks in [`fit`]);
+/// ticks added count in `grown`.
 fn shift(
     p: &mut Problem,
     start: &ChainState,
@@ -163,17 +166,31 @@ fn shift(
     grow: u64,
     grown: &mut u64,
 ) -> Result<Option<Linear>, ExactFailure> {
-    let (Some(cruise), Some(vc), Some(sens)) =
-        (p.cruise, lin.cruise_v, lin.position_sensitivity(p))
-    else {
+    let Some(sens) = lin.position_sensitivity(p) else {
         return Ok(None);
     };
-    let (level, per_tick) = (lin.levels[k], -sens[k] * vc);
+    // The piece whose whole ticks carry the distance, and its speed.
+    let settle = p.pieces.len() - 1;
+    let (donor, speed) = match (p.cruise, lin.cruise_v) {
+        (Some(c), Some(vc)) => (c, vc),
+        _ => {
+            let Some(d) = (0..settle).max_by_key(|&i| p.pieces[i].ticks) else {
+                return Ok(None);
+            };
+            let before = if d == 0 {
+                to_f64(start.v)
+            } else {
+                lin.piece_v[d - 1]
+            };
+            (d, 0.5 * (before + lin.piece_v[d]))
+        }
+    };
+    let (level, per_tick) = (lin.levels[k], -sens[k] * speed);
     if !(per_tick.is_finite() && per_tick != 0.0) {
         return Ok(None);
     }
     let against = level.signum() == -p.guess[k].signum();
-    // m cruise ticks move the level by m·per_tick: the m nearest zero that lands it within.
+    // m donor ticks move the level by m·per_tick: the m nearest zero that lands it within.
     let inside = 1.0 - 1e-6;
     let (a, b) = (
         (-inside * limit - level) / per_tick,
@@ -182,19 +199,19 @@ fn shift(
     let (lo, hi) = (a.min(b), a.max(b));
     let m = if lo > 0.0 { lo.ceil() } else { hi.floor() };
     if !(m >= lo && m <= hi && m.abs() < 1e12) {
-        // No whole number of cruise ticks lands within: the level is too sensitive to them.
+        // No whole number of ticks lands within: the level is too sensitive to them.
         return if hi < 0.0 && against {
             trim(p, start, k, limit)
         } else {
             Ok(None)
         };
     }
-    let n = p.pieces[cruise].ticks;
+    let n = p.pieces[donor].ticks;
     if m >= 1.0 && m < grow as f64 {
-        p.pieces[cruise].ticks += m as u64;
+        p.pieces[donor].ticks += m as u64;
         *grown += m as u64;
     } else if m < 0.0 && ((-m) as u64) < n {
-        p.pieces[cruise].ticks -= (-m) as u64;
+        p.pieces[donor].ticks -= (-m) as u64;
     } else if m < 0.0 && against {
         return trim(p, start, k, limit);
     } else {

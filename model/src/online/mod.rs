@@ -26,7 +26,7 @@ use crate::program::Program;
 
 use exact::{Caps, ExactFailure};
 use position::Branch;
-use problem::{build, Built, Rounding, Setup};
+use problem::{build, Built, Profile, Rounding, Setup};
 use transition::{Entry, Shape, TickLimits};
 
 /// Profile order of an online plan.
@@ -294,6 +294,7 @@ fn setup<'a>(
     {
         caps.entry = a_entry;
     }
+    let cont = problem::Continuous::of(start, o);
     let goal = match *target {
         OnlineTarget::Velocity(_) => None,
         OnlineTarget::Position { cell, .. } => {
@@ -302,13 +303,15 @@ fn setup<'a>(
                 .and_then(|c| c.checked_add(format.half_lsb_raw()))
                 .filter(|c| (*c >> FRAC_BITS) == cell)
                 .ok_or(OnlineError::Overflow)?;
-            // The tail moves the position by 3·v_end (exact::realise).
-            let aim = v_end
-                .checked_mul(3)
+            // The continuous profile ends one tick of v_end past where the program before
+            // the tail ends, and the tail moves the position by 3·v_end (exact::realise).
+            let end = v_end
+                .checked_mul(2)
                 .and_then(|t| centre.checked_sub(t))
                 .ok_or(OnlineError::Overflow)?;
-            let dist = exact::to_f64(aim.checked_sub(start.x).ok_or(OnlineError::Overflow)?);
-            let dir = position::direction(o, v0, a0, dist, v_end as f64, &lim.tick);
+            let dist = exact::to_f64(end.checked_sub(start.x).ok_or(OnlineError::Overflow)?)
+                - cont.dx;
+            let dir = position::direction(o, cont.v, cont.a, dist, v_end as f64, &lim.tick);
             Some((centre, dist, dir))
         }
     };
@@ -320,6 +323,7 @@ fn setup<'a>(
         v_end,
         a_entry,
         caps,
+        cont,
         goal,
     })
 }
@@ -336,7 +340,7 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
     // ticks to a piece whose level is over its limit, and a cruise over the velocity limit
     // lowers the planning velocity. The checks use the true limits throughout.
     let mut last = ExactFailure::Limit;
-    for (scale, extra, rounding) in ATTEMPTS {
+    for (scale, extra, rounding, profile) in ATTEMPTS {
         let mut tick = TickLimits {
             v: lim.tick.v * scale,
             acc: lim.tick.acc * scale,
@@ -349,10 +353,10 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
                 caps,
                 cases,
                 continuous,
-            }) = build(setup, &tick, extra, rounding)?
+            }) = build(setup, &tick, extra, rounding, profile)?
             else {
                 // No profile in this direction with these planning limits.
-                if setup.v_end != 0 && scale == 1.0 {
+                if setup.v_end != 0 && scale == 1.0 && profile == Profile::Optimal {
                     return Err(OnlineError::BlendUnreachable);
                 }
                 break;
@@ -394,18 +398,20 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
 /// The attempts [`plan_online`] makes in order: the limits the continuous profile is planned
 /// with (a fraction of the true ones), the ticks added to every piece but the settle, and how
 /// the pieces are rounded to ticks.
-const ATTEMPTS: [(f64, u64, Rounding); 11] = [
-    (1.0, 0, Rounding::Up),
-    (1.0, 0, Rounding::Nearest),
-    (1.0, 1, Rounding::Up),
-    (1.0 - 1e-4, 0, Rounding::Up),
-    (1.0 - 1e-4, 1, Rounding::Up),
-    (1.0 - 1e-3, 0, Rounding::Up),
-    (1.0 - 1e-3, 2, Rounding::Up),
-    (0.99, 0, Rounding::Up),
-    (0.99, 4, Rounding::Up),
-    (0.95, 0, Rounding::Up),
-    (0.95, 8, Rounding::Up),
+const ATTEMPTS: [(f64, u64, Rounding, Profile); 13] = [
+    (1.0, 0, Rounding::Up, Profile::Optimal),
+    (1.0, 0, Rounding::Nearest, Profile::Optimal),
+    (1.0, 0, Rounding::Up, Profile::Ease),
+    (1.0, 0, Rounding::Nearest, Profile::Ease),
+    (1.0, 1, Rounding::Up, Profile::Optimal),
+    (1.0 - 1e-4, 0, Rounding::Up, Profile::Optimal),
+    (1.0 - 1e-4, 1, Rounding::Up, Profile::Optimal),
+    (1.0 - 1e-3, 0, Rounding::Up, Profile::Optimal),
+    (1.0 - 1e-3, 2, Rounding::Up, Profile::Optimal),
+    (0.99, 0, Rounding::Up, Profile::Optimal),
+    (0.99, 4, Rounding::Up, Profile::Optimal),
+    (0.95, 0, Rounding::Up, Profile::Optimal),
+    (0.95, 8, Rounding::Up, Profile::Optimal),
 ];
 
 /// Plans per scale with a lowered planning velocity when the level solution cruises above the

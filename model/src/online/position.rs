@@ -46,6 +46,9 @@ pub enum Branch {
     Partial,
     /// From beyond the limits, fall to a speed within them, then to the end speed.
     Descend,
+    /// A retry ([`ease`]): brake to the end speed at once, cruise at it, and leave the end
+    /// a short transition from the end speed back to it.
+    Ease,
     /// The fallback: brake to rest, then move on from rest (`super::fallback`).
     Stop,
 }
@@ -241,6 +244,49 @@ pub fn direction(order: u8, v0: f64, a0: f64, x: f64, v_end: f64, lim: &TickLimi
     } else {
         -1.0
     }
+}
+
+/// The profile a plan retries when the time-optimal one cannot be realised near the distance
+/// of braking at once ([`Branch::Ease`]): the transition to the end speed `v_end` at once, a
+/// cruise at it for what distance is left (none at rest), and a transition from `v_end` to
+/// itself. Its last, short pieces carry the ticks' rounding: from a state on the planner's own
+/// trajectory in its final brake they take up the half tick of travel that rounding the brake
+/// adds, which a release at the start cannot. `None` when the end speed cannot be reached by
+/// the target in direction `dir`.
+pub fn ease(
+    order: u8,
+    v0: f64,
+    a0: f64,
+    x: f64,
+    v_end: f64,
+    dir: f64,
+    lim: &TickLimits,
+) -> Option<PositionProfile> {
+    let a0 = if order == 2 { 0.0 } else { a0 };
+    let ahead = Ctx {
+        order,
+        v0,
+        a0,
+        v_end,
+        lim,
+    };
+    let (d_end, first, second) = ahead.through(v_end);
+    let rest = dir * (x - d_end);
+    let cruise = if v_end != 0.0 {
+        if rest < 0.0 {
+            return None;
+        }
+        rest / v_end.abs()
+    } else {
+        0.0
+    };
+    Some(PositionProfile::Through {
+        branch: Branch::Ease,
+        vc: v_end,
+        first,
+        cruise,
+        second,
+    })
 }
 
 /// Plans the move over distance `x` (from the current position) from `(v0, a0)` to end speed

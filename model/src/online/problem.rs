@@ -6,7 +6,7 @@ use arrayvec::ArrayVec;
 
 use crate::chain::ChainState;
 
-use super::exact::{Caps, Condition, DPiece, Problem, MAX_FREE, MAX_PIECES};
+use super::exact::{to_f64, Caps, Condition, DPiece, Problem, MAX_FREE, MAX_PIECES};
 use super::position::{self, PositionProfile};
 use super::transition::{self, TickLimits, Transition};
 use super::{Cases, OnlineError, OnlineTarget, RawLimits};
@@ -39,6 +39,59 @@ impl Rounding {
     }
 }
 
+/// Which continuous profile an attempt realises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Profile {
+    /// The time-optimal one ([`position::plan`]).
+    Optimal,
+    /// Brake to the end speed at once, its rounding taken up at the end ([`position::ease`]).
+    Ease,
+}
+
+/// Where the continuous profile a program realises starts, seen from the registers.
+///
+/// The chain integrates with the left rectangle rule (`x += v; v += a; a += j`, seed 000 eqs
+/// 72–75), so its registers at tick `k` are a continuous profile's `X(k)`, `V(k + ½)`,
+/// `A(k + 1)`, and the jerk register holds the continuous jerk of `[k + 1, k + 2]` (exact for a
+/// piecewise-linear acceleration, to `J/8` where the jerk changes). A program's first piece
+/// sets the jerk on tick 1, so it acts from continuous time 2, and every piece then spans as
+/// many units as it has ticks; the end, where the acceleration reaches zero, is one tick past
+/// the program's last (the settle). Planning the continuous profile from the state at time 2
+/// — `X = x + 2v + a`, `V = v + 3a/2 + 3j/8`, `A = a + j` — rather than from the registers
+/// themselves makes its durations the programs' tick counts up to their fractions, instead of
+/// up to a tick or two of acceleration: what lets a plan from a state on one of the planner's
+/// own trajectories find that trajectory's tick counts again. Order 2: the first level acts on
+/// the acceleration from tick 2, time 2½, where `V = v + 2a + j` and `X = x + 5v/2 + 2a + j/2`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Continuous {
+    /// Velocity (raw per tick).
+    pub v: f64,
+    /// Acceleration (raw per tick²; 0 for order 2, whose levels step).
+    pub a: f64,
+    /// Position past the register (raw).
+    pub dx: f64,
+}
+
+impl Continuous {
+    /// The continuous start for a program of order `o` played from `s`.
+    pub fn of(s: &ChainState, o: u8) -> Continuous {
+        let (v, a, j) = (to_f64(s.v), to_f64(s.a), to_f64(s.j));
+        if o == 2 {
+            Continuous {
+                v: v + 2.0 * a + j,
+                a: 0.0,
+                dx: 2.5 * v + 2.0 * a + 0.5 * j,
+            }
+        } else {
+            Continuous {
+                v: v + 1.5 * a + 0.375 * j,
+                a: a + j,
+                dx: 2.0 * v + a,
+            }
+        }
+    }
+}
+
 /// What every attempt at one plan shares.
 pub(super) struct Setup<'a> {
     pub start: &'a ChainState,
@@ -51,6 +104,8 @@ pub(super) struct Setup<'a> {
     /// The start's acceleration magnitude over its first tick.
     pub a_entry: i128,
     pub caps: Caps,
+    /// The continuous profile's start.
+    pub cont: Continuous,
     /// Position targets: the centre of the target cell (raw), the distance to the goal the
     /// program's main part aims at (raw, real), and the direction (`±1`, chosen once with the
     /// true limits so that no attempt with lowered ones reverses where the first would not).
@@ -68,6 +123,12 @@ pub(super) struct Built {
 
 /// Appends the discrete pieces of a transition: jerk pieces free (order 3), the hold fixed at
 /// zero jerk; order 2: its acceleration piece free.
+///
+/// A jerk piece keeps at least one tick so that its level stays free. Where its real duration
+/// is under a tick and a hold lies beside it (a start already holding its acceleration, an end
+/// that only releases one), that tick comes out of the hold: the two are rounded together, as
+/// one stretch at nearly the same acceleration, and the transition does not grow by a tick it
+/// would have to carry the axis through.
 fn push_transition(
     pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
     guess: &mut [f64; MAX_FREE],
@@ -77,13 +138,34 @@ fn push_transition(
     cap: usize,
     rounding: Rounding,
 ) {
-    for (i, p) in t.pieces().iter().enumerate() {
+    let ps = t.pieces();
+    if std::env::var("DBG").is_ok() { eprintln!("      push {:?}", ps); }
+    let mut ticks = [0u64; 3];
+    for (n, p) in ticks.iter_mut().zip(ps) {
+        *n = rounding.ticks(p.t, 0);
+    }
+    if order == 3 && ps.len() == 3 && ps[1].t > 0.0 {
+        let short = |p: &super::transition::Piece| p.t < 1.0 - 1e-6;
+        let (first, last) = (short(&ps[0]), short(&ps[2]));
+        if first || last {
+            let mut span = ps[1].t;
+            let mut taken = 0;
+            for (i, s) in [(0, first), (2, last)] {
+                if s {
+                    span += ps[i].t;
+                    ticks[i] = 1;
+                    taken += 1;
+                }
+            }
+            ticks[1] = rounding.ticks(span, 0).saturating_sub(taken);
+        }
+    }
+    for (i, p) in ps.iter().enumerate() {
         let is_hold = order == 3 && i == 1;
         if is_hold {
-            let n = rounding.ticks(p.t, 0);
-            if n > 0 {
+            if ticks[i] > 0 {
                 pieces.push(DPiece {
-                    ticks: n,
+                    ticks: ticks[i],
                     free: None,
                     cap,
                     slack: true,
@@ -92,7 +174,7 @@ fn push_transition(
         } else {
             guess[*free] = p.level;
             pieces.push(DPiece {
-                ticks: rounding.ticks(p.t, 1),
+                ticks: ticks[i].max(1),
                 free: Some(*free),
                 cap,
                 slack: false,
@@ -115,16 +197,10 @@ pub(super) fn build(
     tick: &TickLimits,
     extra: u64,
     rounding: Rounding,
+    profile: Profile,
 ) -> Result<Option<Built>, OnlineError> {
-    let (o, start, lim) = (setup.o, setup.start, &setup.lim);
-    let (v0, a0) = (
-        super::exact::to_f64(start.v),
-        if o == 2 {
-            0.0
-        } else {
-            super::exact::to_f64(start.a)
-        },
-    );
+    let (o, lim) = (setup.o, &setup.lim);
+    let (v0, a0) = (setup.cont.v, setup.cont.a);
     let raw_of = |a: f64| {
         if a == tick.acc {
             lim.acc
@@ -160,8 +236,11 @@ pub(super) fn build(
             (cases, t.duration(), 0, t.rise, caps)
         }
         (OnlineTarget::Position { .. }, Some((centre, dist, dir))) => {
-            let Some(prof) = position::plan(o, v0, a0, dist, setup.v_end as f64, dir, tick)
-            else {
+            let plan = match profile {
+                Profile::Optimal => position::plan,
+                Profile::Ease => position::ease,
+            };
+            let Some(prof) = plan(o, v0, a0, dist, setup.v_end as f64, dir, tick) else {
                 return Ok(None);
             };
             match prof {
