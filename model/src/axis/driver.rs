@@ -205,7 +205,7 @@ struct Runner<'l, L: Link> {
     covered: u64,
     /// Swaps that only uploaded the rest of a long change.
     extensions: u32,
-    /// Ticks between polls: how late the host may notice that a swap has passed.
+    /// Ticks between polls.
     poll_ticks: u64,
 }
 
@@ -396,9 +396,9 @@ impl<L: Link> Runner<'_, L> {
     }
 
     /// Whether `timeline`, swapped to at `at`, can be kept on the board: each upload of at
-    /// most the program memory must be followed, once its swap has passed and been seen (a
-    /// poll later), by the upload of the rest (as [`Runner::extend`] leads it) armed before the
-    /// board has played what it holds.
+    /// most the program memory must be followed, once its swap has passed and been seen
+    /// ([`Runner::seen_ticks`] later), by the upload of the rest (as [`Runner::extend`] leads
+    /// it) armed before the board has played what it holds.
     fn coverable(&self, timeline: &super::Timeline, at: u64, margin: f64) -> bool {
         let f = self.axis.settings.format;
         let mut swap = at;
@@ -412,7 +412,7 @@ impl<L: Link> Runner<'_, L> {
             };
             let covered = swap + held.total_ticks();
             let lead = (self.upload_ticks(&held) * 1.25 * margin).ceil() as u64 + SAFETY;
-            let next = swap + self.poll_ticks + lead;
+            let next = swap + self.seen_ticks() + lead;
             if next >= covered {
                 return false;
             }
@@ -451,6 +451,17 @@ impl<L: Link> Runner<'_, L> {
             self.poll()?;
         }
         Err(too_slow())
+    }
+
+    /// Host ticks from a swap to the end of the poll that sees it has passed, at the most: a
+    /// poll period, and two READ_STATE round trips (the one under way when the swap passes
+    /// reads the tick before it).
+    fn seen_ticks(&self) -> u64 {
+        let f = &self.axis.settings.format;
+        let read = frame_bytes(&Command::ReadState, f)
+            + Reply::State(self.last).to_frame(0).to_bytes().len();
+        let round_trip = read as f64 * self.link.byte_ticks() + self.overhead;
+        self.poll_ticks + (2.0 * round_trip).ceil() as u64
     }
 
     /// Host ticks the upload of `p` takes: LOAD_SEGMENTs, COMMIT and SWAP_AT with their

@@ -103,3 +103,128 @@ pub(super) fn stop_and_go(
         },
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::{Quantity, Widths};
+
+    /// Steps `program` from `s` tick by tick; the end, and whether every tick kept the
+    /// velocity, acceleration (while |v| grows) or deceleration (while it shrinks) and (order 3)
+    /// jerk limits.
+    fn step(
+        s: ChainState,
+        program: &Program,
+        l: &OnlineLimits,
+        order: OnlineOrder,
+        f: &Format,
+    ) -> (ChainState, bool) {
+        let w = Widths {
+            x: 127,
+            v: 127,
+            a: 127,
+            j: 127,
+            d: 127,
+        };
+        let raw = |x: f64, q| (x * f.scale(q)).floor() as i128;
+        let (vm, am, dm, jm) = (
+            raw(l.velocity, Quantity::Velocity),
+            raw(l.acceleration, Quantity::Acceleration),
+            raw(l.deceleration, Quantity::Acceleration),
+            raw(l.jerk, Quantity::Jerk),
+        );
+        let mut s = s;
+        let mut within = true;
+        for seg in &program.segments {
+            for k in 0..seg.ticks {
+                s = s.step(if k == 0 { seg.snap } else { 0 }, &w);
+                let next = s.v + s.a;
+                let grows = next.abs() > s.v.abs() || next.signum() * s.v.signum() < 0;
+                let shrinks = next.abs() < s.v.abs() || next.signum() * s.v.signum() < 0;
+                within &= s.v.abs() <= vm
+                    && (order == OnlineOrder::Two || s.j.abs() <= jm)
+                    && !(grows && s.a.abs() > am)
+                    && !(shrinks && s.a.abs() > dm);
+            }
+        }
+        (s, within)
+    }
+
+    /// Braking to rest and moving on lands exactly, within the limits, from moving states
+    /// and to a target ahead, behind or where the brake ends, and to a velocity.
+    #[test]
+    fn stop_and_go_is_exact_and_within_the_limits() {
+        let f = Format::default();
+        let l = OnlineLimits {
+            velocity: 0.5,
+            acceleration: 2.0,
+            deceleration: 1.5,
+            jerk: 20.0,
+        };
+        let start = ChainState {
+            x: f.home_raw(),
+            v: (0.4 * f.scale(Quantity::Velocity)) as i128,
+            a: (-0.8 * f.scale(Quantity::Acceleration)) as i128,
+            j: 0,
+        };
+        for order in [OnlineOrder::Three, OnlineOrder::Two] {
+            let start = if order == OnlineOrder::Two {
+                ChainState { a: 0, ..start }
+            } else {
+                start
+            };
+            for target in [
+                OnlineTarget::Position {
+                    cell: 300_000,
+                    velocity: 0.0,
+                },
+                OnlineTarget::Position {
+                    cell: -20_000,
+                    velocity: 0.0,
+                },
+                OnlineTarget::Velocity(-0.3),
+            ] {
+                let s = setup(&start, &target, &l, order, &f).expect("valid");
+                let p = stop_and_go(&s, &l, order, &f).expect("plans");
+                assert_eq!(p.cases.branch, Some(Branch::Stop));
+                let (end, within) = step(start, &p.program, &l, order, &f);
+                assert_eq!(end, p.final_state, "{order:?} {target:?}");
+                assert!(within, "{order:?} {target:?}: a limit exceeded");
+                match target {
+                    OnlineTarget::Position { cell, .. } => {
+                        assert!(end.is_at_rest());
+                        assert_eq!(f.output_lsb(end.x), cell);
+                    }
+                    OnlineTarget::Velocity(v) => {
+                        let raw = (v * f.scale(Quantity::Velocity)).round() as i128;
+                        assert_eq!((end.v, end.a, end.j), (raw, 0, 0));
+                    }
+                }
+            }
+            // Where the brake ends: nothing more than the brake.
+            let brake = attempts(
+                &setup(&start, &OnlineTarget::Velocity(0.0), &l, order, &f).expect("valid"),
+                &f,
+            )
+            .expect("brakes");
+            let cell = f.output_lsb(brake.final_state.x);
+            let target = OnlineTarget::Position {
+                cell,
+                velocity: 0.0,
+            };
+            let p = stop_and_go(&setup(&start, &target, &l, order, &f).expect("valid"), &l, order, &f)
+                .expect("plans");
+            assert_eq!(p.program, brake.program);
+        }
+        // A blend point is refused.
+        let target = OnlineTarget::Position {
+            cell: 300_000,
+            velocity: 0.2,
+        };
+        let s = setup(&start, &target, &l, OnlineOrder::Three, &f).expect("valid");
+        assert!(matches!(
+            stop_and_go(&s, &l, OnlineOrder::Three, &f),
+            Err(OnlineError::NotRealisable(_))
+        ));
+    }
+}

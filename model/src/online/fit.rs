@@ -174,7 +174,11 @@ fn shift(
     let (donor, speed) = match (p.cruise, lin.cruise_v) {
         (Some(c), Some(vc)) => (c, vc),
         _ => {
-            let Some(d) = (0..settle).max_by_key(|&i| p.pieces[i].ticks) else {
+            // Not the level's own piece: its ticks move its level too much.
+            let Some(d) = (0..settle)
+                .filter(|&i| p.pieces[i].free != Some(k))
+                .max_by_key(|&i| p.pieces[i].ticks)
+            else {
                 return Ok(None);
             };
             let before = if d == 0 {

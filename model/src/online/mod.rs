@@ -361,12 +361,10 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
                 }
                 break;
             };
-            if std::env::var("DBG").is_ok() { eprintln!("attempt {scale} {extra} {rounding:?} rt {retarget}: {:?} cont {continuous} pieces {:?} guess {:?}", cases, problem.pieces.iter().map(|p| (p.ticks, p.free)).collect::<Vec<_>>(), problem.guess); }
             let lin = match fit::fit(&mut problem, start, &caps) {
                 Ok(lin) => lin,
                 Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
                 Err(e) => {
-                    if std::env::var("DBG").is_ok() { eprintln!("  fit failed {e:?}"); }
                     last = e;
                     break;
                 }
@@ -385,7 +383,6 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
                 }
                 Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
                 Err(e) => {
-                    if std::env::var("DBG").is_ok() { eprintln!("  realise failed {e:?} levels {:?} pieces {:?}", lin.levels, problem.pieces.iter().map(|p| p.ticks).collect::<Vec<_>>()); }
                     last = e;
                     break;
                 }

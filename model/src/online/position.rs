@@ -405,3 +405,129 @@ pub fn plan(
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIM: TickLimits = TickLimits {
+        v: 10.0,
+        acc: 4.0,
+        dec: 3.0,
+        j: 1.0,
+    };
+
+    /// Integrates `(level, duration)` pieces of jerk independently, in small exact steps;
+    /// returns the final (x, v, a) and the largest |a| and |v| on the way.
+    fn integrate(v0: f64, a0: f64, pieces: &[(f64, f64)]) -> ((f64, f64, f64), f64, f64) {
+        let (mut x, mut v, mut a) = (0.0, v0, a0);
+        let (mut peak_a, mut peak_v) = (a0.abs(), v0.abs());
+        for &(level, t) in pieces {
+            let n = 4000;
+            let dt = t / n as f64;
+            for _ in 0..n {
+                x += v * dt + a * dt * dt / 2.0 + level * dt * dt * dt / 6.0;
+                v += a * dt + level * dt * dt / 2.0;
+                a += level * dt;
+                peak_a = peak_a.max(a.abs());
+                peak_v = peak_v.max(v.abs());
+            }
+        }
+        ((x, v, a), peak_a, peak_v)
+    }
+
+    fn pieces(p: &PositionProfile) -> Vec<(f64, f64)> {
+        let of = |t: &Transition| t.pieces().iter().map(|p| (p.level, p.t)).collect::<Vec<_>>();
+        match p {
+            PositionProfile::Through {
+                first,
+                cruise,
+                second,
+                ..
+            } => [of(first), vec![(0.0, *cruise)], of(second)].concat(),
+            PositionProfile::Partial { release, fall } => {
+                [vec![(release.level, release.t)], of(fall)].concat()
+            }
+        }
+    }
+
+    /// Every branch, planned and then integrated here: it ends at the end speed with zero
+    /// acceleration, having covered the distance, within the acceleration limit.
+    #[test]
+    fn every_branch_ends_on_its_distance_at_its_speed() {
+        // (v0, a0, x, v_end, branch)
+        let cases = [
+            (0.0, 0.0, 500.0, 0.0, Branch::Cruise),
+            (0.0, 0.0, 30.0, 0.0, Branch::Peak),
+            (2.0, 1.0, 30.0, 1.0, Branch::Peak),
+            // Braking at 2 from 6: a brake released in part covers from its own distance
+            // (8.x) up to releasing fully and braking again.
+            (6.0, -2.0, 9.6, 0.0, Branch::Partial),
+            (6.0, -2.0, 11.0, 2.0, Branch::Partial),
+            // Beyond the speed limit (lowered to 10 while at 14).
+            (14.0, 0.0, 60.0, 0.0, Branch::Descend),
+            // Moving away from the target: reverses.
+            (-3.0, 0.0, 20.0, 0.0, Branch::Peak),
+        ];
+        for (v0, a0, x, v_end, branch) in cases {
+            let dir = direction(3, v0, a0, x, v_end, &LIM);
+            let p = plan(3, v0, a0, x, v_end, dir, &LIM)
+                .unwrap_or_else(|| panic!("{v0} {a0} {x} {v_end}: no profile"));
+            assert_eq!(p.branch(), branch, "{v0} {a0} {x} {v_end}");
+            let ((xe, ve, ae), peak_a, peak_v) = integrate(v0, a0, &pieces(&p));
+            let what = format!("{v0} {a0} {x} {v_end}: ended at {xe} {ve} {ae}");
+            assert!((xe - x).abs() < 1e-6 * x.abs().max(1.0), "{what}");
+            assert!((ve - v_end).abs() < 1e-6, "{what}");
+            assert!(ae.abs() < 1e-6, "{what}");
+            assert!(peak_a <= LIM.acc.max(a0.abs()) + 1e-9, "{what}: |a| {peak_a}");
+            if branch != Branch::Descend {
+                assert!(peak_v <= LIM.v + 1e-9, "{what}: |v| {peak_v}");
+            }
+        }
+    }
+
+    /// The partial release is faster than releasing the brake fully and braking again (what a
+    /// peak at the intermediate speed would do), and no slower than braking at once.
+    #[test]
+    fn a_partial_release_beats_releasing_fully() {
+        let (v0, a0, v_end) = (6.0, -2.0, 0.0);
+        let c = Ctx {
+            order: 3,
+            v0,
+            a0,
+            v_end,
+            lim: &LIM,
+        };
+        let vi = intermediate_speed(v0, a0, LIM.j);
+        let (d_brake, d_release) = (c.d(v_end), c.d(vi));
+        let x = 0.5 * (d_brake + d_release);
+        let p = plan(3, v0, a0, x, v_end, 1.0, &LIM).expect("plans");
+        assert_eq!(p.branch(), Branch::Partial);
+        let released = c.through(vi);
+        let full = released.1.duration() + released.2.duration();
+        let brake = velocity(3, v0, a0, v_end, &LIM).duration();
+        assert!(p.duration() < full, "{} ≥ {full}", p.duration());
+        assert!(p.duration() >= brake, "{} < {brake}", p.duration());
+    }
+
+    /// The ease profile brakes to the end speed at once and cruises the rest.
+    #[test]
+    fn the_ease_profile_brakes_at_once_and_cruises_the_rest() {
+        let p = ease(3, 6.0, -1.0, 40.0, 2.0, 1.0, &LIM).expect("plans");
+        assert_eq!(p.branch(), Branch::Ease);
+        let ((xe, ve, ae), _, _) = integrate(6.0, -1.0, &pieces(&p));
+        assert!((xe - 40.0).abs() < 1e-6 && (ve - 2.0).abs() < 1e-9 && ae.abs() < 1e-9);
+        // A blend point before the end speed can be reached.
+        assert!(ease(3, 6.0, -1.0, 1.0, 2.0, 1.0, &LIM).is_none());
+    }
+
+    #[test]
+    fn brents_method_finds_roots_to_the_tolerance() {
+        let r = root(|x| x * x * x - 2.0, 0.0, -2.0, 2.0, 6.0, 1e-12);
+        assert!((r - 2f64.powf(1.0 / 3.0)).abs() < 1e-11, "{r}");
+        // A root at an end, and a function flat near its root.
+        assert_eq!(root(|x| x, 0.0, 0.0, 1.0, 1.0, 0.0), 0.0);
+        let r = root(|x| (x - 0.3).powi(5), 0.0, -(0.3f64.powi(5)), 1.0, 0.7f64.powi(5), 0.0);
+        assert!((r - 0.3).abs() < 1e-3, "{r}");
+    }
+}

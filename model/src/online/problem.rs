@@ -139,7 +139,7 @@ fn push_transition(
     rounding: Rounding,
 ) {
     let ps = t.pieces();
-    if std::env::var("DBG").is_ok() { eprintln!("      push {:?}", ps); }
+
     let mut ticks = [0u64; 3];
     for (n, p) in ticks.iter_mut().zip(ps) {
         *n = rounding.ticks(p.t, 0);
@@ -346,4 +346,85 @@ pub(super) fn build(
         cases,
         continuous,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::Widths;
+
+    /// The chain's registers are the continuous profile's X(k), V(k + ½), A(k + 1): a program
+    /// of jerk pieces played tick by tick lands where the continuous profile from
+    /// [`Continuous::of`] integrated exactly over the pieces' tick counts says, to the
+    /// rectangle rule's `J/8`-sized terms at the pieces' joints.
+    #[test]
+    fn the_continuous_start_is_where_the_chain_plays_from() {
+        let w = Widths {
+            x: 127,
+            v: 127,
+            a: 127,
+            j: 127,
+            d: 127,
+        };
+        let starts = [
+            ChainState::at_rest(0),
+            ChainState {
+                x: 0,
+                v: 1_000_000_000,
+                a: 0,
+                j: 0,
+            },
+            ChainState {
+                x: 0,
+                v: 5_000_000_000,
+                a: -3_000_000,
+                j: 0,
+            },
+            ChainState {
+                x: 0,
+                v: -2_000_000_000,
+                a: 4_000_000,
+                j: -7_000,
+            },
+        ];
+        // (jerk level, ticks) and a settle tick of zero jerk.
+        let program = [(9_000i128, 300u64), (0, 120), (-9_000, 300), (-4_000, 77), (0, 1)];
+        for s in starts {
+            // Discrete: each piece sets its jerk on its first tick.
+            let mut d = s;
+            for &(level, n) in &program {
+                d = d.step(level - d.j, &w);
+                for _ in 1..n {
+                    d = d.step(0, &w);
+                }
+            }
+            // Continuous: from time 2, exact per piece; the settle's zero jerk ends it.
+            let c = Continuous::of(&s, 3);
+            let (mut x, mut v, mut a) = (to_f64(s.x) + c.dx, c.v, c.a);
+            let free = &program[..program.len() - 1];
+            for &(level, n) in free {
+                let (t, l) = (n as f64, level as f64);
+                x += v * t + a * t * t / 2.0 + l * t * t * t / 6.0;
+                v += a * t + l * t * t / 2.0;
+                a += l * t;
+            }
+            // The program's last tick N: a_N = A(N + 1), the continuous end.
+            assert_eq!(to_f64(d.a), a, "{s:?}: acceleration");
+            // v_N = V(N + ½) = V(N + 1) − A/2 + L/8 (the last piece's jerk L over the half
+            // tick), and x_N = X(N + 1) − V(N + ½).
+            let last = free[free.len() - 1].0 as f64;
+            let v_half = v - a / 2.0 + last / 8.0;
+            let joints = free.len() as f64;
+            let tol_v = joints * 9_000.0 / 4.0 + 7_000.0;
+            assert!((to_f64(d.v) - v_half).abs() <= tol_v, "{s:?}: v {} vs {v_half}", d.v);
+            let ticks: u64 = program.iter().map(|p| p.1).sum();
+            let tol_x = tol_v * ticks as f64;
+            assert!(
+                (to_f64(d.x) - (x - v_half)).abs() <= tol_x,
+                "{s:?}: x {} vs {}",
+                d.x,
+                x - v_half
+            );
+        }
+    }
 }
