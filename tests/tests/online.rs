@@ -9,7 +9,9 @@
 //! * an override cut (set speed lowered, even from 200 % to 10 %) never undershoots the new
 //!   speed and never reverses, and a state left outside lowered limits is brought back within
 //!   without reversal;
-//! * the duration is within a stated bound of Ruckig's (rsruckig) from the same state.
+//! * the duration is within a stated bound of Ruckig's (rsruckig) from the same state;
+//! * a target at rest or a velocity is never refused (the planner falls back on braking to
+//!   rest and moving on, docs/MODEL.md §11), and how often it falls back is bounded.
 //!
 //! `PROPTEST_CASES` raises the case count.
 
@@ -17,7 +19,10 @@ mod util;
 
 use proptest::prelude::*;
 use rsruckig::prelude::*;
-use snapgen_model::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
+use snapgen_model::online::position::Branch;
+use snapgen_model::online::{
+    plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlinePlan, OnlineTarget,
+};
 use snapgen_model::{ChainState, Format, Program, Quantity};
 
 /// Per-tick facts of a trace stepped here.
@@ -181,12 +186,8 @@ proptest! {
         let start = state_within(&f, &l, su, order);
         let cell = f.output_lsb(start.x) + dist as i128;
         let target = OnlineTarget::Position { cell, velocity: 0.0 };
-        let p = match plan_online(&start, &target, &l, order, &f) {
-            Ok(p) => p,
-            // A typed refusal, counted by `refusals_are_rare` below; never a wrong program.
-            Err(OnlineError::NotRealisable(_)) => return Ok(()),
-            Err(e) => panic!("{start:?} → {cell}: {e}"),
-        };
+        let p = plan_online(&start, &target, &l, order, &f)
+            .unwrap_or_else(|e| panic!("{start:?} → {cell} within {l:?}: {e}"));
         let t = step(start, &p.program);
         prop_assert!(t.end.is_at_rest(), "not at rest: {:?}", t.end);
         prop_assert_eq!(f.output_lsb(t.end.x), cell);
@@ -246,6 +247,86 @@ proptest! {
             Err(OnlineError::BlendUnreachable | OnlineError::NotRealisable(_)) => {}
             Err(e) => panic!("{start:?} → {cell} at {vb}: {e}"),
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(util::proptest_cases(256)))]
+
+    /// An override cut: the set speed lowered to 5–95 % of the speed the axis moves at, from a
+    /// state within the old limits or beyond the new ones (up to twice the speed limit and
+    /// three times the acceleration). Where braking the start's acceleration at full jerk does
+    /// not itself take the speed below the new set speed (seed 002 eq 32), the speed never
+    /// drops below it and never reverses; the end is exact.
+    #[test]
+    fn an_override_cut_never_undershoots_or_reverses(
+        lu in [unit(), unit(), unit(), unit()],
+        vu in 0.2..2.0f64,
+        au in -1.0..3.0f64,
+        cut in 0.05..0.95f64,
+        order in order(),
+    ) {
+        let f = Format::default();
+        let l = limits_from(lu);
+        let r = raw(&f, &l);
+        let v0 = vu * r.v as f64;
+        let a0 = if order == OnlineOrder::Three {
+            au * r.acc.min(r.dec) as f64
+        } else {
+            0.0
+        };
+        let start = ChainState {
+            x: f.home_raw(),
+            v: v0 as i128,
+            a: a0 as i128,
+            j: 0,
+        };
+        let vs = cut * v0.min(r.v as f64) / f.scale(Quantity::Velocity);
+        let vs_raw = (vs * f.scale(Quantity::Velocity)).round() as i128;
+        let vi = if order == OnlineOrder::Three {
+            v0 + a0 * a0.abs() / (2.0 * r.j as f64)
+        } else {
+            v0
+        };
+        prop_assume!(vi > vs_raw as f64 * (1.0 + 1e-3));
+        let p = plan_online(&start, &OnlineTarget::Velocity(vs), &l, order, &f)
+            .unwrap_or_else(|e| panic!("{start:?} → {vs} within {l:?}: {e}"));
+        let t = step(start, &p.program);
+        prop_assert_eq!((t.end.v, t.end.a, t.end.j), (vs_raw, 0, 0));
+        prop_assert!(t.min_v >= vs_raw, "undershoot to {} below {vs_raw}", t.min_v);
+    }
+
+    /// The duration from a random state within the limits (symmetric, as Ruckig's) to a random
+    /// target at rest, against Ruckig's from the same state: within the bound docs/MODEL.md
+    /// §11 states (at most 2 ticks shorter, and no longer than `RUCKIG_ABOVE_TICKS` ticks or
+    /// `RUCKIG_ABOVE_SHARE` of Ruckig's duration, whichever is more). A plan that fell back on
+    /// braking to rest (about 1 in 20 000 states; counted and bounded by the seeded tests
+    /// below) is exact but slower, and is left out here.
+    #[test]
+    fn the_duration_is_within_the_stated_bound_of_ruckigs(
+        lu in [unit(), unit(), unit(), unit()],
+        su in [unit(), unit(), unit(), unit(), unit()],
+        dist in -3e5..3e5f64,
+    ) {
+        let f = Format::default();
+        let mut l = limits_from(lu);
+        l.deceleration = l.acceleration;
+        let start = ChainState {
+            j: 0,
+            ..state_within(&f, &l, su, OnlineOrder::Three)
+        };
+        let cell = f.output_lsb(start.x) + dist as i128;
+        let target = OnlineTarget::Position { cell, velocity: 0.0 };
+        let p = plan_online(&start, &target, &l, OnlineOrder::Three, &f)
+            .unwrap_or_else(|e| panic!("{start:?} → {cell} within {l:?}: {e}"));
+        prop_assume!(!stopped(&p));
+        let theirs = ruckig_duration(&f, &start, cell, &l) / f.ts;
+        let over = p.ticks() as f64 - theirs;
+        prop_assert!(over >= -2.0, "{over:.1} ticks shorter than Ruckig's {theirs:.0}");
+        prop_assert!(
+            over <= ruckig_bound(&f, &start, cell, &l, theirs),
+            "{over:.1} ticks over Ruckig's {theirs:.0}"
+        );
     }
 }
 
@@ -324,10 +405,65 @@ fn a_state_beyond_lowered_limits_comes_back_without_reversal() {
     assert!(t.max_j <= raw(&f, &l).j);
 }
 
-/// Bounds met on the seeded set (docs/MODEL.md §11): ticks over Ruckig, median and 90th
-/// percentile (measured 7.7 and 12.2).
-const MEDIAN_ABOVE_RUCKIG: f64 = 10.0;
-const P90_ABOVE_RUCKIG: f64 = 20.0;
+/// The bound met against Ruckig (docs/MODEL.md §11): on the seeded set, the median, 90th and
+/// 99th percentile of the ticks over Ruckig's duration (measured 7.4, 10.8, 14.7); on every
+/// plan, no more than `RUCKIG_ABOVE_TICKS` ticks or `RUCKIG_ABOVE_SHARE` of Ruckig's duration
+/// over it, whichever is more (measured: at most 49 ticks on the seeded set; 126 ticks, 0.23 %,
+/// over 20 000 states), or `NEAR_STOP_SHARE` of it for a target within `NEAR_STOP_TICKS` ticks
+/// of travel of where braking at once stops the axis: there the integer chain, whose brake
+/// cannot be shortened by a fraction of a tick, may have to reverse by a hair (or brake and
+/// move on) where the continuous profile just stops.
+const MEDIAN_ABOVE_RUCKIG: f64 = 9.0;
+const P90_ABOVE_RUCKIG: f64 = 13.0;
+const P99_ABOVE_RUCKIG: f64 = 20.0;
+const RUCKIG_ABOVE_TICKS: f64 = 64.0;
+const RUCKIG_ABOVE_SHARE: f64 = 0.003;
+const NEAR_STOP_TICKS: f64 = 8.0;
+const NEAR_STOP_SHARE: f64 = 0.02;
+
+/// The most a plan may take over Ruckig's `theirs` ticks (the bound above).
+fn ruckig_bound(f: &Format, start: &ChainState, cell: i128, l: &OnlineLimits, theirs: f64) -> f64 {
+    let share = if near_stop(f, start, cell, l) {
+        NEAR_STOP_SHARE
+    } else {
+        RUCKIG_ABOVE_SHARE
+    };
+    RUCKIG_ABOVE_TICKS.max(share * theirs)
+}
+
+/// Whether the target cell lies within `NEAR_STOP_TICKS` ticks of travel of where braking at
+/// once stops the axis (Ruckig's brake to zero velocity, symmetric limits).
+fn near_stop(f: &Format, start: &ChainState, cell: i128, l: &OnlineLimits) -> bool {
+    let mut i = InputParameter::new(None);
+    i.control_interface = ControlInterface::Velocity;
+    i.current_position = daov_stack![f.position_physical(start.x)];
+    i.current_velocity = daov_stack![f.to_physical(Quantity::Velocity, start.v)];
+    i.current_acceleration = daov_stack![f.to_physical(Quantity::Acceleration, start.a)];
+    i.target_velocity = daov_stack![0.0];
+    i.max_velocity = daov_stack![l.velocity];
+    i.max_acceleration = daov_stack![l.acceleration];
+    i.max_jerk = daov_stack![l.jerk];
+    let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, f.ts);
+    let mut traj = Trajectory::new(None);
+    otg.calculate(&i, &mut traj).expect("Ruckig brakes");
+    let mut stop = daov_stack![0.0];
+    traj.at_time(
+        traj.get_duration(),
+        &mut Some(&mut stop),
+        &mut None,
+        &mut None,
+        &mut None,
+        &mut None,
+    );
+    let target = f.position_physical((cell << snapgen_model::FRAC_BITS) + f.half_lsb_raw());
+    let travel = f.to_physical(Quantity::Velocity, start.v).abs() * f.ts;
+    (target - stop[0]).abs() <= NEAR_STOP_TICKS * travel
+}
+
+/// Whether a plan fell back on braking to rest and moving on.
+fn stopped(p: &OnlinePlan) -> bool {
+    p.cases.branch == Some(Branch::Stop)
+}
 
 /// Ruckig's duration (s) from the same state, continuous time, symmetric limits.
 fn ruckig_duration(f: &Format, start: &ChainState, cell: i128, l: &OnlineLimits) -> f64 {
@@ -347,15 +483,15 @@ fn ruckig_duration(f: &Format, start: &ChainState, cell: i128, l: &OnlineLimits)
     traj.get_duration()
 }
 
-/// 2000 seeded states within the limits (symmetric, as Ruckig's), random targets at rest: how
-/// many plans are refused, and the duration against Ruckig's.
+/// 2000 seeded states within the limits (symmetric, as Ruckig's), random targets at rest: none
+/// refused, how many fell back on braking to rest, and the duration against Ruckig's.
 #[test]
 fn durations_against_ruckig_and_refusals() {
     use rand::{Rng, SeedableRng};
     let f = Format::default();
     let mut rng = rand::rngs::StdRng::seed_from_u64(2026);
     let mut diffs = Vec::new();
-    let mut refused = 0;
+    let mut stops = 0;
     let cases = 2000;
     for _ in 0..cases {
         let mut lu = [0.0; 4];
@@ -371,63 +507,48 @@ fn durations_against_ruckig_and_refusals() {
             cell,
             velocity: 0.0,
         };
-        let p = match plan_online(&start, &target, &l, OnlineOrder::Three, &f) {
-            Ok(p) => p,
-            Err(OnlineError::NotRealisable(_)) => {
-                refused += 1;
-                continue;
-            }
-            Err(e) => panic!("{start:?} → {cell} {l:?}: {e}"),
-        };
+        let p = plan_online(&start, &target, &l, OnlineOrder::Three, &f)
+            .unwrap_or_else(|e| panic!("{start:?} → {cell} {l:?}: {e}"));
+        stops += usize::from(stopped(&p));
         let ours = p.ticks() as f64;
         let theirs = ruckig_duration(&f, &start, cell, &l) / f.ts;
-        diffs.push(ours - theirs);
+        diffs.push((ours - theirs, ruckig_bound(&f, &start, cell, &l, theirs)));
     }
-    diffs.sort_by(|a, b| a.total_cmp(b));
+    diffs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let n = diffs.len();
+    let d = |q: usize| diffs[q].0;
     eprintln!(
-        "refused {refused} of {cases}; ticks over Ruckig: min {:.2} median {:.2} p90 {:.2} p99 {:.2} max {:.2}",
-        diffs[0],
-        diffs[n / 2],
-        diffs[n * 9 / 10],
-        diffs[n * 99 / 100],
-        diffs[n - 1]
-    );
-    assert!(
-        refused * 200 <= cases,
-        "{refused} of {cases} refused (bound 0.5 %)"
+        "{stops} of {cases} braked to rest first; ticks over Ruckig: min {:.2} median {:.2} p90 {:.2} p99 {:.2} max {:.2}",
+        d(0),
+        d(n / 2),
+        d(n * 9 / 10),
+        d(n * 99 / 100),
+        d(n - 1)
     );
     // Never faster than the continuous optimum by more than the chain's own tick offsets.
-    assert!(
-        diffs[0] >= -2.0,
-        "{:.2} ticks faster than Ruckig",
-        -diffs[0]
-    );
-    // The bound met on most states; the tail (measured p99 24 ticks, worst 5.7 % of the move
-    // on a reversal) is a known gap, reported above and in docs/MODEL.md §11.
-    assert!(
-        diffs[n / 2] <= MEDIAN_ABOVE_RUCKIG,
-        "median {:.2} ticks over Ruckig",
-        diffs[n / 2]
-    );
-    assert!(
-        diffs[n * 9 / 10] <= P90_ABOVE_RUCKIG,
-        "p90 {:.2} ticks over Ruckig",
-        diffs[n * 9 / 10]
-    );
+    assert!(d(0) >= -2.0, "{:.2} ticks faster than Ruckig", -d(0));
+    assert!(d(n / 2) <= MEDIAN_ABOVE_RUCKIG, "median {:.2}", d(n / 2));
+    assert!(d(n * 9 / 10) <= P90_ABOVE_RUCKIG, "p90 {:.2}", d(n * 9 / 10));
+    assert!(d(n * 99 / 100) <= P99_ABOVE_RUCKIG, "p99 {:.2}", d(n * 99 / 100));
+    for &(over, bound) in &diffs {
+        assert!(over <= bound, "{over:.1} ticks over Ruckig's (bound {bound:.0})");
+    }
+    assert!(stops * 200 <= cases, "{stops} of {cases} braked to rest first");
 }
 
 /// Replans from states on the planner's own trajectories (a host's feed override or a new
 /// target arrives while a move runs): three moves from rest (seed 002's limits at its three
 /// jerks, in mm with the default 1 nm LSB) in both orders; from every ~1/60th of each, the
 /// same target again at rest and a blend at half the velocity limit. Every plan made is
-/// stepped here: exact end, within the limits on every tick. Refusals are counted (measured:
-/// 1 of 720 replans; BlendUnreachable, a blend point already passed, is a right answer and
-/// not counted); the bound is 1 %.
+/// stepped here: exact end, within the limits on every tick. None is refused at rest (a blend
+/// point already passed, BlendUnreachable, is a right answer; a blend may be refused, counted);
+/// the plans that brake to rest first are counted (measured: 7 of 720, all from states in the
+/// final brake of a jerk-limited move whose rounding asks one tick more than the brake
+/// playing), bound 2 %.
 #[test]
 fn replans_from_states_on_a_trajectory_are_exact_and_rarely_refused() {
     let f = Format::default();
-    let (mut refused, mut made, mut asked) = (0, 0, 0);
+    let (mut refused, mut made, mut asked, mut stops) = (0, 0, 0, 0);
     for order in [OnlineOrder::Three, OnlineOrder::Two] {
         for (v, a, d, j, cell) in [
             (200.0, 4000.0, 3000.0, 500_000.0, 30_000_000i128),
@@ -455,13 +576,14 @@ fn replans_from_states_on_a_trajectory_are_exact_and_rarely_refused() {
                     let p = match plan_online(&s, &to(vb), &l, order, &f) {
                         Ok(p) => p,
                         Err(OnlineError::BlendUnreachable) if vb != 0.0 => continue,
-                        Err(OnlineError::NotRealisable(_)) => {
+                        Err(OnlineError::NotRealisable(_)) if vb != 0.0 => {
                             refused += 1;
                             continue;
                         }
                         Err(e) => panic!("{what}: {e}"),
                     };
                     made += 1;
+                    stops += usize::from(stopped(&p));
                     let t = step(s, &p.program);
                     let v_raw = (vb * f.scale(Quantity::Velocity)).round() as i128;
                     assert_eq!((t.end.v, t.end.a, t.end.j), (v_raw, 0, 0), "{what}");
@@ -471,10 +593,14 @@ fn replans_from_states_on_a_trajectory_are_exact_and_rarely_refused() {
             }
         }
     }
-    eprintln!("{refused} of {asked} replans refused, {made} made");
+    eprintln!("{refused} of {asked} replans refused, {made} made, {stops} braked to rest first");
     assert!(made > asked / 2, "only {made} of {asked} replans made");
     assert!(
         refused * 100 <= asked,
-        "{refused} of {asked} replans refused (bound 1 %)"
+        "{refused} of {asked} blends refused (bound 1 %)"
+    );
+    assert!(
+        stops * 50 <= asked,
+        "{stops} of {asked} replans braked to rest first (bound 2 %)"
     );
 }
