@@ -57,15 +57,7 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
         "replans: {} program swaps played ({} drawn too long; refused by the online planner: {}), {} late swaps refused by the core, {} armed swaps cancelled by a stop{}",
         r.replans,
         r.replans_too_long,
-        if r.replans_refused.is_empty() {
-            "none".to_string()
-        } else {
-            r.replans_refused
-                .iter()
-                .map(|(k, n)| format!("{n} {k}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        },
+        tally(&r.replans_refused),
         r.late_swaps - r.late_swaps_taken,
         r.swaps_cancelled,
         if r.swap_faults() > 0 {
@@ -77,6 +69,27 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
             String::new()
         }
     );
+    if r.streams > 0 {
+        println!(
+            "PLCopen event streams: {} played, {} commands, {} program swaps ({} of them uploading the rest of a long change); commands in Error: {}; {} ended holding a velocity (aborted after){}{}",
+            r.streams,
+            r.stream_commands,
+            r.stream_swaps,
+            r.stream_extensions,
+            tally(&r.stream_errors),
+            r.streams_aborted,
+            if r.streams_diverged > 0 {
+                format!("; {} diverged from the host's prediction (must be 0)", r.streams_diverged)
+            } else {
+                String::new()
+            },
+            if r.streams_failed.is_empty() {
+                String::new()
+            } else {
+                format!("; runs that failed: {}", tally(&r.streams_failed))
+            }
+        );
+    }
     if r.planner_disagreements > 0 {
         println!(
             "{} moves ended where the planner did not predict",
@@ -90,6 +103,18 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
         print_bench(&verilog, cfg, &r)?;
     }
     Ok(r)
+}
+
+/// `n kind, …` of a tally, or `none`.
+fn tally(t: &std::collections::BTreeMap<String, usize>) -> String {
+    if t.is_empty() {
+        "none".to_string()
+    } else {
+        t.iter()
+            .map(|(k, n)| format!("{n} {k}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 /// Timed runs of the benchmark: the co-simulation and the model alone, each [`BENCH_RUNS`]

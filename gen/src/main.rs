@@ -95,6 +95,12 @@ enum Command {
         /// ticks, each planned online from the state at its tick (docs/PROTOCOL.md, SWAP_AT).
         #[arg(long, default_value_t = snapgen_sim::moves::DEFAULT_REPLAN_SHARE)]
         replan_share: f64,
+        /// Share of the moves played instead as PLCopen event streams: 3 to 12 random
+        /// MC_MoveAbsolute (every buffer mode), MC_MoveVelocity, MC_Halt and override changes
+        /// at random ticks, each change planned and its swap led by the host axis's driver over
+        /// the core's ports (docs/ONLINE.md).
+        #[arg(long, default_value_t = snapgen_sim::moves::DEFAULT_STREAM_SHARE)]
+        stream_share: f64,
         /// Dump the whole run's waves to this VCD file.
         #[arg(long)]
         vcd: Option<PathBuf>,
@@ -643,6 +649,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             order,
             stop_share,
             replan_share,
+            stream_share,
             vcd,
             mismatch_vcd,
             bench,
@@ -656,11 +663,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             cfg.mix = order;
             cfg.stop_share = stop_share;
             cfg.replan_share = replan_share;
+            cfg.stream_share = stream_share;
             cfg.vcd = vcd;
             cfg.mismatch_vcd = mismatch_vcd;
             cfg.fault = inject_fault.map(|s| parse_fault(&s)).transpose()?;
             let r = hw::cosim(&cfg, bench)?;
-            if r.mismatch.is_some() || r.planner_disagreements > 0 || r.swap_faults() > 0 {
+            if r.mismatch.is_some()
+                || r.planner_disagreements > 0
+                || r.swap_faults() > 0
+                || r.streams_diverged > 0
+            {
                 return Err(anyhow::Error::new(Mismatched));
             }
         }

@@ -23,6 +23,8 @@ use snapgen_model::{
     plan_from, ChainState, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT,
 };
 
+mod streams;
+
 use crate::build::build;
 use crate::fabric::{Fabric, VcdWindow, CORE_OUTPUTS, OUT_SLOTS, OUT_WORDS};
 use crate::moves::{log_uniform, MoveSpec, MoveStream, OrderMix};
@@ -235,6 +237,8 @@ pub struct CosimConfig {
     pub stop_share: f64,
     /// Share of the other moves replanned on the way (program swaps at random ticks).
     pub replan_share: f64,
+    /// Share of the moves played as PLCopen event streams through the host axis.
+    pub stream_share: f64,
     /// Dump the whole run's waves here.
     pub vcd: Option<PathBuf>,
     /// Where to write the waves around a mismatch.
@@ -261,6 +265,7 @@ impl CosimConfig {
             mix: OrderMix::Mixed,
             stop_share: crate::moves::DEFAULT_STOP_SHARE,
             replan_share: crate::moves::DEFAULT_REPLAN_SHARE,
+            stream_share: crate::moves::DEFAULT_STREAM_SHARE,
             vcd: None,
             mismatch_vcd: PathBuf::from("cosim-mismatch.vcd"),
             fault: None,
@@ -341,6 +346,25 @@ pub struct CosimReport {
     pub swaps_not_armed: usize,
     /// Armed swaps cancelled by a controlled stop before their tick.
     pub swaps_cancelled: usize,
+    /// PLCopen event streams played (each a random script through the host axis and its
+    /// driver).
+    pub streams: usize,
+    /// Program swaps the streams' driver made (each planned from the exact state at its tick
+    /// and armed ahead of the link), extensions of long changes among them.
+    pub stream_swaps: usize,
+    /// Of `stream_swaps`, those that only uploaded the rest of a change longer than the
+    /// program memory.
+    pub stream_extensions: usize,
+    /// Commands the streams gave.
+    pub stream_commands: usize,
+    /// Commands that ended in Error, by ErrorID (a planner refusal, a link too slow).
+    pub stream_errors: std::collections::BTreeMap<String, usize>,
+    /// Streams whose driver read registers that differ from its prediction (must be 0).
+    pub streams_diverged: usize,
+    /// Streams whose run ended otherwise in error, by message.
+    pub streams_failed: std::collections::BTreeMap<String, usize>,
+    /// Streams still moving when their script ended (a velocity held), aborted at the end.
+    pub streams_aborted: usize,
     /// Clocks compared.
     pub clocks: u64,
     /// Ticks compared (clocks on which the chain stepped with a program or a stop).
@@ -522,7 +546,13 @@ fn session(
             },
             2,
         )?;
-        let mut stream = MoveStream::new(cfg.seed, cfg.mix, cfg.stop_share, cfg.replan_share);
+        let mut stream = MoveStream::new(
+            cfg.seed,
+            cfg.mix,
+            cfg.stop_share,
+            cfg.replan_share,
+            cfg.stream_share,
+        );
         let mut fixed = cfg.fixed.iter().flatten();
         let mut played = 0;
         while played < cfg.moves {
@@ -551,6 +581,19 @@ fn session(
                 )?;
                 ls.drive(&idle, 1)?;
                 report.loads += 1;
+            }
+            if spec.stream > 0 {
+                ls.move_index = played;
+                let idle = CoreInputs {
+                    tick_div: spec.tick_div,
+                    ..Default::default()
+                };
+                streams::stream(&mut ls, &spec, &idle, report)?;
+                ls.drive(&idle, 3)?;
+                played += 1;
+                report.moves = played;
+                bar.inc(1);
+                continue;
             }
             let f = Format::with_ts(spec.ts);
             let plan = match plan_from(&spec.request, &f, ls.side.model.chain()) {
@@ -1028,6 +1071,18 @@ pub fn run(verilog: &str, cfg: &CosimConfig) -> Result<CosimReport, SimError> {
         report.late_swaps_taken += r.late_swaps_taken;
         report.swaps_not_armed += r.swaps_not_armed;
         report.swaps_cancelled += r.swaps_cancelled;
+        report.streams += r.streams;
+        report.stream_swaps += r.stream_swaps;
+        report.stream_extensions += r.stream_extensions;
+        report.stream_commands += r.stream_commands;
+        for (k, n) in &r.stream_errors {
+            *report.stream_errors.entry(k.clone()).or_default() += n;
+        }
+        report.streams_diverged += r.streams_diverged;
+        for (k, n) in &r.streams_failed {
+            *report.streams_failed.entry(k.clone()).or_default() += n;
+        }
+        report.streams_aborted += r.streams_aborted;
         report.clocks += r.clocks;
         report.ticks += r.ticks;
         report.planner_disagreements += r.planner_disagreements;

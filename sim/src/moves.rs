@@ -5,7 +5,8 @@
 //! the state the stop begins from), some with a second request or an abort during the stop.
 //! A share of the moves that play to their end is replanned on the way: a chain of program
 //! swaps at random ticks (docs/PROTOCOL.md, SWAP_AT), drawn in the co-simulation from
-//! `replan_seed` (see `crate::cosim`).
+//! `replan_seed` (see `crate::cosim`). A share of the moves are PLCopen event streams instead:
+//! random scripts of commands played through the host axis and its driver.
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -60,8 +61,13 @@ pub struct MoveSpec {
     pub abort_stop_after: Option<u64>,
     /// Online replans of this move (program swaps at random ticks; 0: none).
     pub replans: u8,
-    /// Seed of the replans' random choices (when, where to, with which limits).
+    /// Seed of the replans' random choices (when, where to, with which limits), and of a
+    /// stream's script.
     pub replan_seed: u64,
+    /// Events of a PLCopen event stream played instead of the move (0: none): random
+    /// MC_MoveAbsolute (every buffer mode), MC_MoveVelocity, MC_Halt and override changes
+    /// through the host axis (`crate::cosim`).
+    pub stream: u8,
 }
 
 impl MoveSpec {
@@ -78,6 +84,7 @@ impl MoveSpec {
             abort_stop_after: None,
             replans: 0,
             replan_seed: 0,
+            stream: 0,
         }
     }
 }
@@ -88,12 +95,15 @@ pub struct MoveStream {
     mix: OrderMix,
     stop_share: f64,
     replan_share: f64,
+    stream_share: f64,
 }
 
 /// The share of moves given a controlled stop by default.
 pub const DEFAULT_STOP_SHARE: f64 = 0.25;
 /// The share of the remaining moves replanned on the way by default.
 pub const DEFAULT_REPLAN_SHARE: f64 = 0.2;
+/// The share of the moves played as PLCopen event streams by default.
+pub const DEFAULT_STREAM_SHARE: f64 = 0.1;
 
 /// A number drawn log-uniformly from `lo..=hi`.
 pub fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
@@ -101,15 +111,23 @@ pub fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
 }
 
 impl MoveStream {
-    /// The stream for `seed`, with a controlled stop in a share `stop_share` of the moves
-    /// (each stopping tick takes the stop unit's decision, about 130 clocks) and 1 to 8
-    /// online replans in a share `replan_share` of the others.
-    pub fn new(seed: u64, mix: OrderMix, stop_share: f64, replan_share: f64) -> Self {
+    /// The stream for `seed`: a share `stream_share` of the moves are PLCopen event streams
+    /// (3 to 12 events); of the others, a share `stop_share` get a controlled stop (each
+    /// stopping tick takes the stop unit's decision, about 130 clocks) and a share
+    /// `replan_share` of the rest 1 to 8 online replans.
+    pub fn new(
+        seed: u64,
+        mix: OrderMix,
+        stop_share: f64,
+        replan_share: f64,
+        stream_share: f64,
+    ) -> Self {
         MoveStream {
             rng: StdRng::seed_from_u64(seed),
             mix,
             stop_share: stop_share.clamp(0.0, 1.0),
             replan_share: replan_share.clamp(0.0, 1.0),
+            stream_share: stream_share.clamp(0.0, 1.0),
         }
     }
 
@@ -212,17 +230,25 @@ impl MoveStream {
             } else {
                 0
             };
+        let replan_seed = r.gen();
+        // Drawn last, so that a stream share of 0 leaves every other draw as it was.
+        let stream = if self.stream_share > 0.0 && r.gen_bool(self.stream_share) {
+            r.gen_range(3..=12)
+        } else {
+            0
+        };
         MoveSpec {
             request: MoveRequest { distance, method },
             ts,
             tick_div,
-            abort_after,
-            stop_after,
+            abort_after: abort_after.filter(|_| stream == 0),
+            stop_after: stop_after.filter(|_| stream == 0),
             stop_limits: StopLimits { jerk, accel },
             stop_again_after,
             abort_stop_after,
-            replans,
-            replan_seed: r.gen(),
+            replans: if stream == 0 { replans } else { 0 },
+            replan_seed,
+            stream,
         }
     }
 }

@@ -528,12 +528,26 @@ fn durations_against_ruckig_and_refusals() {
     // Never faster than the continuous optimum by more than the chain's own tick offsets.
     assert!(d(0) >= -2.0, "{:.2} ticks faster than Ruckig", -d(0));
     assert!(d(n / 2) <= MEDIAN_ABOVE_RUCKIG, "median {:.2}", d(n / 2));
-    assert!(d(n * 9 / 10) <= P90_ABOVE_RUCKIG, "p90 {:.2}", d(n * 9 / 10));
-    assert!(d(n * 99 / 100) <= P99_ABOVE_RUCKIG, "p99 {:.2}", d(n * 99 / 100));
+    assert!(
+        d(n * 9 / 10) <= P90_ABOVE_RUCKIG,
+        "p90 {:.2}",
+        d(n * 9 / 10)
+    );
+    assert!(
+        d(n * 99 / 100) <= P99_ABOVE_RUCKIG,
+        "p99 {:.2}",
+        d(n * 99 / 100)
+    );
     for &(over, bound) in &diffs {
-        assert!(over <= bound, "{over:.1} ticks over Ruckig's (bound {bound:.0})");
+        assert!(
+            over <= bound,
+            "{over:.1} ticks over Ruckig's (bound {bound:.0})"
+        );
     }
-    assert!(stops * 200 <= cases, "{stops} of {cases} braked to rest first");
+    assert!(
+        stops * 200 <= cases,
+        "{stops} of {cases} braked to rest first"
+    );
 }
 
 /// Replans from states on the planner's own trajectories (a host's feed override or a new
@@ -603,4 +617,120 @@ fn replans_from_states_on_a_trajectory_are_exact_and_rarely_refused() {
         stops * 50 <= asked,
         "{stops} of {asked} replans braked to rest first (bound 2 %)"
     );
+}
+
+/// Starts that no program keeps within the new limits, met by the co-simulation's random
+/// PLCopen streams (docs/MODEL.md §11): braking so hard that releasing at full jerk still takes
+/// the speed through zero with more acceleration than the other side allows; first ticks (whose
+/// accelerations are already decided) that carry the speed over the new limit or through zero.
+/// Each is planned — to rest, or to a velocity — exact at its end, and its acceleration never
+/// goes beyond the start's own.
+#[test]
+fn starts_with_an_inevitable_excursion_are_planned() {
+    let cases = [
+        // Braking at 29 unit/s² at 0.028 unit/s; new acceleration limit 9 (deceleration 814).
+        (
+            ChainState {
+                x: 6737740593234717703369152772654,
+                v: 334037700051419921847535,
+                a: -3540152143380918593975,
+                j: 0,
+            },
+            OnlineTarget::Position {
+                cell: 5583005,
+                velocity: 0.0,
+            },
+            OnlineLimits {
+                velocity: 0.12618630054041355,
+                acceleration: 9.0748898038313,
+                deceleration: 813.8742230686198,
+                jerk: 10400.996115740869,
+            },
+            OnlineOrder::Three,
+            1e-5,
+        ),
+        // Order 2 at 2.065 unit/s, accelerating at 543: its next two ticks pass 2.152.
+        (
+            ChainState {
+                x: 6472228522161360925439987724544,
+                v: -249662554321957146204212998,
+                a: -6570067218998872268531921,
+                j: 0,
+            },
+            OnlineTarget::Position {
+                cell: -2456327,
+                velocity: 0.0,
+            },
+            OnlineLimits {
+                velocity: 2.1522365032711046,
+                acceleration: 548.7803496185712,
+                deceleration: 16.566693369109416,
+                jerk: 209.63342933247472,
+            },
+            OnlineOrder::Two,
+            1e-4,
+        ),
+        // Ts = 1 ms: the release's ticks carry 0.878 unit/s past 1.006.
+        (
+            ChainState {
+                x: 3346902322843052601990844062051,
+                v: 1061156996831051948530779713,
+                a: 20759048843058982190821944,
+                j: 0,
+            },
+            OnlineTarget::Position {
+                cell: 12218715,
+                velocity: 0.0,
+            },
+            OnlineLimits {
+                velocity: 1.0061616020296997,
+                acceleration: 17.43378174133318,
+                deceleration: 102.3857380012521,
+                jerk: 1396.9936805553034,
+            },
+            OnlineOrder::Three,
+            1e-3,
+        ),
+        // Beyond the new speed and deceleration limits, to a velocity the other way.
+        (
+            ChainState {
+                x: 11366669957371524144351211515447,
+                v: -5250414661653931555280091,
+                a: 335233263008642468662,
+                j: 0,
+            },
+            OnlineTarget::Velocity(-0.07978065881536284),
+            OnlineLimits {
+                velocity: 0.07978065881536284,
+                acceleration: 1.1726256559005777,
+                deceleration: 2.1174272334465476,
+                jerk: 1575.9500465582591,
+            },
+            OnlineOrder::Three,
+            1e-5,
+        ),
+    ];
+    for (start, target, l, order, ts) in cases {
+        let f = Format::with_ts(ts);
+        let what = format!("{start:?} → {target:?} within {l:?}");
+        let p =
+            plan_online(&start, &target, &l, order, &f).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let t = step(start, &p.program);
+        match target {
+            OnlineTarget::Position { cell, .. } => {
+                assert!(t.end.is_at_rest(), "{what}");
+                assert_eq!(f.output_lsb(t.end.x), cell, "{what}");
+            }
+            OnlineTarget::Velocity(v) => {
+                let raw = (v * f.scale(Quantity::Velocity)).round() as i128;
+                assert_eq!((t.end.v, t.end.a, t.end.j), (raw, 0, 0), "{what}");
+            }
+        }
+        let r = raw(&f, &l);
+        let own = start.a.abs().max((start.a + start.j).abs());
+        assert!(
+            t.max_acc.max(t.max_dec) <= own.max(r.acc.max(r.dec)),
+            "{what}: acceleration beyond the start's own"
+        );
+    }
 }

@@ -196,6 +196,9 @@ pub struct DPiece {
     /// A piece at zero level (a hold or the cruise) whose ticks may be lent to a neighbouring
     /// free piece that needs more time (`fit` in the planner).
     pub slack: bool,
+    /// A hold: the sign of the acceleration it holds in the continuous profile (`+1` in a
+    /// rising transition, `−1` in a falling one); 0 for other pieces.
+    pub held: i8,
 }
 
 /// An end condition: a register at the end of a piece.
@@ -490,7 +493,11 @@ impl Lu {
         let n = self.n;
         let mut y = [0.0; MAX_FREE];
         for i in 0..n {
-            let dot: f64 = self.lu[i][..i].iter().zip(&y[..i]).map(|(l, y)| l * y).sum();
+            let dot: f64 = self.lu[i][..i]
+                .iter()
+                .zip(&y[..i])
+                .map(|(l, y)| l * y)
+                .sum();
             y[i] = r[self.perm[i]] - dot;
         }
         for i in (0..n).rev() {
@@ -831,8 +838,9 @@ pub fn check_limits(
 }
 
 /// Checks the `n` ticks of one zero-snap segment played from `s` and ending in `end`: split
-/// where the acceleration changes sign (it is linear in the tick), each part has its
-/// extremes at its ends.
+/// where the acceleration changes sign (it is linear in the tick), each part has a monotone
+/// velocity and its extremes at its ends; a part whose velocity changes sign is split there too
+/// ([`check_part`]).
 fn check_run(
     caps: &Caps,
     cap: usize,
@@ -842,12 +850,13 @@ fn check_run(
 ) -> Result<(), ExactFailure> {
     let ov = ExactFailure::Overflow;
     let first = one_tick(s, 0).ok_or(ov)?;
-    if first.a.signum() * end.a.signum() >= 0 {
-        return check_ticks(caps, cap, &first, end);
-    }
-    // The state k ticks in is `first` advanced k − 1; a(k) = first.a + (k − 1)·first.j. The
-    // last tick on the first one's side of zero, estimated and then made exact.
+    // The state k ticks in is `first` advanced k − 1.
     let at = |k: u64| zero_snap(&first, k - 1).ok_or(ov);
+    if first.a.signum() * end.a.signum() >= 0 {
+        return check_part(caps, cap, &at, (1, &first), (n, end));
+    }
+    // a(k) = first.a + (k − 1)·first.j. The last tick on the first one's side of zero,
+    // estimated and then made exact.
     let a = |k: u64| {
         i128::from(k - 1)
             .checked_mul(first.j)
@@ -867,8 +876,55 @@ fn check_run(
     while k < n && a(k + 1)?.signum() != -side {
         k += 1;
     }
-    check_ticks(caps, cap, &first, &at(k)?)?;
-    check_ticks(caps, cap, &at(k + 1)?, end)
+    check_part(caps, cap, &at, (1, &first), (k, &at(k)?))?;
+    check_part(caps, cap, &at, (k + 1, &at(k + 1)?), (n, end))
+}
+
+/// Checks ticks `k₀..=k₁` of a zero-snap segment (`at(k)` the state `k` ticks in; `p`, `q` the
+/// states at the two ends), across which the acceleration keeps its sign, so the velocity is
+/// monotone. Where the velocity passes through zero the limit that applies changes: the ticks
+/// before, whose acceleration shrinks |v|, have the deceleration limit; the tick whose
+/// acceleration takes the velocity through zero counts as both (the smaller limit); the ticks
+/// after, where |v| grows, the acceleration limit. So the part is split around that tick,
+/// found by bisection: exact, where one check of the whole part would apply the smaller limit
+/// to every tick.
+fn check_part(
+    caps: &Caps,
+    cap: usize,
+    at: &impl Fn(u64) -> Result<ChainState, ExactFailure>,
+    (k0, p): (u64, &ChainState),
+    (k1, q): (u64, &ChainState),
+) -> Result<(), ExactFailure> {
+    let side = p.v.signum();
+    let after = q.v.saturating_add(q.a);
+    if side == 0 || (q.v.signum() == side && after.signum() == side) {
+        // No crossing in the part, nor right after it.
+        return check_ticks(caps, cap, p, q);
+    }
+    // The crossing tick: the last on p's side of zero.
+    let crossing = if q.v.signum() == side {
+        k1
+    } else {
+        let (mut lo, mut hi) = (k0, k1);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if at(mid)?.v.signum() == side {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    let c = at(crossing)?;
+    if crossing > k0 {
+        check_ticks(caps, cap, p, &at(crossing - 1)?)?;
+    }
+    check_ticks(caps, cap, &c, &c)?;
+    if crossing < k1 {
+        check_ticks(caps, cap, &at(crossing + 1)?, q)?;
+    }
+    Ok(())
 }
 
 /// Checks the ticks from `p` to `q` of one segment, across which the acceleration keeps its

@@ -212,8 +212,13 @@ mod tests {
                 cell,
                 velocity: 0.0,
             };
-            let p = stop_and_go(&setup(&start, &target, &l, order, &f).expect("valid"), &l, order, &f)
-                .expect("plans");
+            let p = stop_and_go(
+                &setup(&start, &target, &l, order, &f).expect("valid"),
+                &l,
+                order,
+                &f,
+            )
+            .expect("plans");
             assert_eq!(p.program, brake.program);
         }
         // A blend point is refused.

@@ -55,7 +55,7 @@ pub(super) fn fit(
         for i in 0..p.pieces.len() {
             let d = p.pieces[i];
             // The planned sign of a piece's level or acceleration: the guess of its level, or
-            // (a hold) of the jerk piece before it. The other sign gets the smaller limit.
+            // (a hold) of the acceleration it holds. The other sign gets the smaller limit.
             let a_limit = |value: f64, planned: f64| {
                 if value.signum() != planned.signum() {
                     caps.acc.min(caps.dec) as f64
@@ -89,7 +89,7 @@ pub(super) fn fit(
                 }
                 None if p.order == 3 && is_hold(p, i) && i > 0 => {
                     let a = lin.piece_a[i];
-                    let planned = p.pieces[i - 1].free.map_or(a, |k| p.guess[k]);
+                    let planned = if d.held != 0 { f64::from(d.held) } else { a };
                     let ratio = a.abs() / a_limit(a, planned);
                     if !ratio.is_finite() {
                         return Err(ExactFailure::Overflow);

@@ -217,11 +217,10 @@ pub fn plan_online(
     let setup = setup(start, target, limits, order, format)?;
     match attempts(&setup, format) {
         Err(OnlineError::NotRealisable(why)) => {
-            fallback::stop_and_go(&setup, limits, order, format)
-                .map_err(|e| match e {
-                    OnlineError::NotRealisable(_) => OnlineError::NotRealisable(why),
-                    e => e,
-                })
+            fallback::stop_and_go(&setup, limits, order, format).map_err(|e| match e {
+                OnlineError::NotRealisable(_) => OnlineError::NotRealisable(why),
+                e => e,
+            })
         }
         r => r,
     }
@@ -250,23 +249,43 @@ fn setup<'a>(
         });
     }
     let v_end = v_raw_f as i128;
-    let (v0, a0) = (
-        exact::to_f64(start.v),
-        if o == 2 { 0.0 } else { exact::to_f64(start.a) },
-    );
+    // The continuous profile the chain plays from here (problem::Continuous): its speed once
+    // the ticks already decided have played, and the speed braking its acceleration at full
+    // jerk reaches (seed 002 eq 32).
+    let cont = problem::Continuous::of(start, o);
+    let (v0, a0) = (cont.v, cont.a);
     let vi = if o == 2 {
         v0
     } else {
         transition::intermediate_speed(v0, a0, lim.tick.j)
     };
     let next_a = start.a.saturating_add(start.j);
+    // The velocities after the first two ticks, whose accelerations (a, then a + j) are
+    // already decided: no program changes them.
+    let v1 = start.v.saturating_add(start.a);
+    let v2 = v1.saturating_add(next_a);
+    // The speed the chain reaches releasing the acceleration at full jerk from the third tick
+    // on (order 3): `a₁ − mJ` for m = 1, 2, … while it keeps a₁'s sign, each added to the
+    // velocity, `M·a₁ − J·M(M+1)/2` in all (M terms) — the discrete counterpart of v_i.
+    let vi_ticks = if o == 3 {
+        let a1 = exact::to_f64(next_a);
+        let j = lim.tick.j;
+        let m = ((a1.abs() / j) - 1e-9).ceil().max(1.0) - 1.0;
+        exact::to_f64(v2) + a1.signum() * (m * a1.abs() - j * m * (m + 1.0) / 2.0)
+    } else {
+        exact::to_f64(v2)
+    };
     // A start whose speed is or will be beyond the limit (limits lowered mid-move) is only
     // promised to come back without reversal: its velocity is capped by the register alone.
-    let outside = vi.abs() > lim.tick.v || start.v.abs() > lim.v;
+    let outside = vi.abs() > lim.tick.v
+        || vi_ticks.abs() > lim.tick.v
+        || start.v.abs() > lim.v
+        || v1.saturating_abs() > lim.v
+        || v2.saturating_abs() > lim.v;
     let excursion_v = if outside {
         Format::register_max(format.widths.v)
     } else {
-        start.v.saturating_add(start.a).saturating_abs()
+        v1.saturating_abs().max(v2.saturating_abs())
     };
     let a_entry = start.a.saturating_abs().max(next_a.saturating_abs());
     let mut caps = Caps {
@@ -294,7 +313,23 @@ fn setup<'a>(
     {
         caps.entry = a_entry;
     }
-    let cont = problem::Continuous::of(start, o);
+    // So does a start braking so hard that releasing the brake at full jerk still takes it
+    // through zero speed with the acceleration beyond the limit of the other side (where |v|
+    // grows: the acceleration limit, often far below the deceleration one): at the crossing
+    // `a_z² = a₀² − 2J·|v₀|` (the speed the release loses, `(a₀² − a_z²)/2J`, is |v₀|). No
+    // program avoids that excursion.
+    if o == 3 && v0 * vi < 0.0 {
+        let a_z = (a0 * a0 - 2.0 * lim.tick.j * v0.abs()).max(0.0).sqrt();
+        if a_z > lim.tick.acc {
+            caps.entry = caps.entry.max(a_entry);
+        }
+    }
+    // And a start whose first two ticks (decided) take it through zero speed with an
+    // acceleration beyond the smaller limit (a crossing tick counts as both).
+    let crosses = |p: i128, q: i128| p.signum() * q.signum() < 0;
+    if (crosses(start.v, v1) || crosses(v1, v2)) && a_entry > lim.acc.min(lim.dec) {
+        caps.entry = caps.entry.max(a_entry);
+    }
     let goal = match *target {
         OnlineTarget::Velocity(_) => None,
         OnlineTarget::Position { cell, .. } => {
@@ -309,8 +344,8 @@ fn setup<'a>(
                 .checked_mul(2)
                 .and_then(|t| centre.checked_sub(t))
                 .ok_or(OnlineError::Overflow)?;
-            let dist = exact::to_f64(end.checked_sub(start.x).ok_or(OnlineError::Overflow)?)
-                - cont.dx;
+            let dist =
+                exact::to_f64(end.checked_sub(start.x).ok_or(OnlineError::Overflow)?) - cont.dx;
             let dir = position::direction(o, cont.v, cont.a, dist, v_end as f64, &lim.tick);
             Some((centre, dist, dir))
         }
@@ -379,7 +414,15 @@ fn attempts(setup: &Setup, format: &Format) -> Result<OnlinePlan, OnlineError> {
             }
             match exact::realise(&problem, start, &caps, &lin, &mut program) {
                 Ok(fin) => {
-                    return finish(start, &setup.target, format, program, fin, continuous, cases)
+                    return finish(
+                        start,
+                        &setup.target,
+                        format,
+                        program,
+                        fin,
+                        continuous,
+                        cases,
+                    )
                 }
                 Err(ExactFailure::Overflow) => return Err(OnlineError::Overflow),
                 Err(e) => {

@@ -135,11 +135,7 @@ impl Ctx<'_> {
         let v1 = v0 + a0 * t + j * t * t / 2.0;
         let x1 = v0 * t + a0 * t * t / 2.0 + j * t * t * t / 6.0;
         let fall = velocity(3, v1, a1, self.v_end, self.lim);
-        (
-            x1 + fall.distance(3, v1, a1),
-            Piece { t, level: j },
-            fall,
-        )
+        (x1 + fall.distance(3, v1, a1), Piece { t, level: j }, fall)
     }
 
     /// The `v` in `[lo, hi]` with `D(v) = x`, given `d_lo = D(lo) ≤ x ≤ D(hi) = d_hi`.
@@ -385,10 +381,7 @@ pub fn plan(
         );
         let (_, release, _) = c.partial(t);
         // The fall from the state the release leaves, unmirrored.
-        let (v1, a1) = (
-            v0 + a0 * t + s * lim.j * t * t / 2.0,
-            a0 + s * lim.j * t,
-        );
+        let (v1, a1) = (v0 + a0 * t + s * lim.j * t * t / 2.0, a0 + s * lim.j * t);
         let fall = velocity(3, v1, a1, v_end, lim);
         return Some(PositionProfile::Partial {
             release: Piece {
@@ -437,7 +430,12 @@ mod tests {
     }
 
     fn pieces(p: &PositionProfile) -> Vec<(f64, f64)> {
-        let of = |t: &Transition| t.pieces().iter().map(|p| (p.level, p.t)).collect::<Vec<_>>();
+        let of = |t: &Transition| {
+            t.pieces()
+                .iter()
+                .map(|p| (p.level, p.t))
+                .collect::<Vec<_>>()
+        };
         match p {
             PositionProfile::Through {
                 first,
@@ -479,7 +477,10 @@ mod tests {
             assert!((xe - x).abs() < 1e-6 * x.abs().max(1.0), "{what}");
             assert!((ve - v_end).abs() < 1e-6, "{what}");
             assert!(ae.abs() < 1e-6, "{what}");
-            assert!(peak_a <= LIM.acc.max(a0.abs()) + 1e-9, "{what}: |a| {peak_a}");
+            assert!(
+                peak_a <= LIM.acc.max(a0.abs()) + 1e-9,
+                "{what}: |a| {peak_a}"
+            );
             if branch != Branch::Descend {
                 assert!(peak_v <= LIM.v + 1e-9, "{what}: |v| {peak_v}");
             }
@@ -527,7 +528,14 @@ mod tests {
         assert!((r - 2f64.powf(1.0 / 3.0)).abs() < 1e-11, "{r}");
         // A root at an end, and a function flat near its root.
         assert_eq!(root(|x| x, 0.0, 0.0, 1.0, 1.0, 0.0), 0.0);
-        let r = root(|x| (x - 0.3).powi(5), 0.0, -(0.3f64.powi(5)), 1.0, 0.7f64.powi(5), 0.0);
+        let r = root(
+            |x| (x - 0.3).powi(5),
+            0.0,
+            -(0.3f64.powi(5)),
+            1.0,
+            0.7f64.powi(5),
+            0.0,
+        );
         assert!((r - 0.3).abs() < 1e-3, "{r}");
     }
 }

@@ -169,6 +169,7 @@ fn push_transition(
                     free: None,
                     cap,
                     slack: true,
+                    held: if t.rise { 1 } else { -1 },
                 });
             }
         } else {
@@ -178,6 +179,7 @@ fn push_transition(
                 free: Some(*free),
                 cap,
                 slack: false,
+                held: 0,
             });
             *free += 1;
         }
@@ -213,13 +215,12 @@ pub(super) fn build(
     let mut pieces = ArrayVec::new();
     let mut conditions = ArrayVec::new();
     let mut cruise = None;
-    let push = |pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
-                guess: &mut [f64; MAX_FREE],
-                free: &mut usize,
-                t: &Transition,
-                cap: usize| {
-        push_transition(pieces, guess, free, t, o, cap, rounding)
-    };
+    let push =
+        |pieces: &mut ArrayVec<DPiece, MAX_PIECES>,
+         guess: &mut [f64; MAX_FREE],
+         free: &mut usize,
+         t: &Transition,
+         cap: usize| { push_transition(pieces, guess, free, t, o, cap, rounding) };
     let (cases, continuous, x_centre, rise, caps) = match (setup.target, setup.goal) {
         (OnlineTarget::Velocity(_), _) | (_, None) => {
             let t = transition::velocity(o, v0, a0, setup.v_end as f64, tick);
@@ -258,6 +259,7 @@ pub(super) fn build(
                         free: None,
                         cap: 2,
                         slack: true,
+                        held: 0,
                     });
                     if o == 3 {
                         conditions.push(Condition::A(pieces.len() - 1));
@@ -286,6 +288,7 @@ pub(super) fn build(
                         free: Some(free),
                         cap: 0,
                         slack: false,
+                        held: 0,
                     });
                     free += 1;
                     push(&mut pieces, &mut guess, &mut free, &fall, 0);
@@ -311,6 +314,7 @@ pub(super) fn build(
         free: None,
         cap: 2,
         slack: false,
+        held: 0,
     });
     if o == 3 {
         conditions.push(Condition::A(pieces.len() - 1));
@@ -388,7 +392,13 @@ mod tests {
             },
         ];
         // (jerk level, ticks) and a settle tick of zero jerk.
-        let program = [(9_000i128, 300u64), (0, 120), (-9_000, 300), (-4_000, 77), (0, 1)];
+        let program = [
+            (9_000i128, 300u64),
+            (0, 120),
+            (-9_000, 300),
+            (-4_000, 77),
+            (0, 1),
+        ];
         for s in starts {
             // Discrete: each piece sets its jerk on its first tick.
             let mut d = s;
@@ -416,7 +426,11 @@ mod tests {
             let v_half = v - a / 2.0 + last / 8.0;
             let joints = free.len() as f64;
             let tol_v = joints * 9_000.0 / 4.0 + 7_000.0;
-            assert!((to_f64(d.v) - v_half).abs() <= tol_v, "{s:?}: v {} vs {v_half}", d.v);
+            assert!(
+                (to_f64(d.v) - v_half).abs() <= tol_v,
+                "{s:?}: v {} vs {v_half}",
+                d.v
+            );
             let ticks: u64 = program.iter().map(|p| p.1).sum();
             let tol_x = tol_v * ticks as f64;
             assert!(
