@@ -554,15 +554,14 @@ fn check_pieces(
     let mut s = *start;
     for (q, end) in jp.zip(ends) {
         let l = q.level.exact(lv).ok_or(ov)?;
-        // The one-tick segment that sets the jerk.
+        // The one-tick segment that sets the jerk: from its tick on the acceleration is linear
+        // (the jerk is the level), so the piece's ticks are one zero-snap run from it.
         let first = one_tick(&s, l.checked_sub(s.j).ok_or(ov)?).ok_or(ov)?;
-        check_ticks(caps, q.cap, &first, &first)?;
         let rest = q.ticks - 1;
         if rest <= u64::from(u32::MAX) {
-            if rest > 0 {
-                check_run(caps, q.cap, &first, end, rest)?;
-            }
+            check_from(caps, q.cap, &first, end, q.ticks)?;
         } else {
+            check_ticks(caps, q.cap, &first, &first)?;
             // Written in segments of at most u32::MAX ticks: each checked on its own.
             let mut from = first;
             let mut left = rest;
@@ -848,10 +847,37 @@ fn check_run(
     end: &ChainState,
     n: u64,
 ) -> Result<(), ExactFailure> {
+    let first = one_tick(s, 0).ok_or(ExactFailure::Overflow)?;
+    check_from(caps, cap, &first, end, n)
+}
+
+/// [`check_run`] given the state after the run's first tick, `first` (a zero-snap run from
+/// there on: a piece whose first tick set its jerk is one).
+fn check_from(
+    caps: &Caps,
+    cap: usize,
+    first: &ChainState,
+    end: &ChainState,
+    n: u64,
+) -> Result<(), ExactFailure> {
     let ov = ExactFailure::Overflow;
-    let first = one_tick(s, 0).ok_or(ov)?;
-    // The state k ticks in is `first` advanced k − 1.
-    let at = |k: u64| zero_snap(&first, k - 1).ok_or(ov);
+    let first = *first;
+    // The state k ticks in: `first` advanced k − 1, the ends and their neighbours directly
+    // (the last tick but one is the end stepped back: a − j, then v − a, then x − v).
+    let at = |k: u64| -> Result<ChainState, ExactFailure> {
+        if k == 1 {
+            Ok(first)
+        } else if k == n {
+            Ok(*end)
+        } else if k + 1 == n {
+            let a = end.a.checked_sub(end.j).ok_or(ov)?;
+            let v = end.v.checked_sub(a).ok_or(ov)?;
+            let x = end.x.checked_sub(v).ok_or(ov)?;
+            Ok(ChainState { x, v, a, j: end.j })
+        } else {
+            zero_snap(&first, k - 1).ok_or(ov)
+        }
+    };
     if first.a.signum() * end.a.signum() >= 0 {
         return check_part(caps, cap, &at, (1, &first), (n, end));
     }
@@ -864,7 +890,7 @@ fn check_run(
             .ok_or(ov)
     };
     let side = first.a.signum();
-    let est = (-(first.a as f64) / first.j as f64).floor() + 1.0;
+    let est = (-to_f64(first.a) / to_f64(first.j)).floor() + 1.0;
     let mut k = if est.is_finite() {
         (est.max(1.0) as u64).min(n)
     } else {
@@ -901,20 +927,39 @@ fn check_part(
         // No crossing in the part, nor right after it.
         return check_ticks(caps, cap, p, q);
     }
-    // The crossing tick: the last on p's side of zero.
+    // The crossing tick: the last on p's side of zero. The velocity m ticks after p is
+    // `v + m·a + C(m,2)·j` (monotone here): its root estimated in f64, then made exact.
     let crossing = if q.v.signum() == side {
         k1
     } else {
-        let (mut lo, mut hi) = (k0, k1);
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if at(mid)?.v.signum() == side {
-                lo = mid;
+        let (v, a, j) = (to_f64(p.v), to_f64(p.a), to_f64(p.j));
+        let m = if j == 0.0 {
+            -v / a
+        } else {
+            // (j/2)·m² + (a − j/2)·m + v = 0: the root between the part's ends.
+            let (qa, qb) = (0.5 * j, a - 0.5 * j);
+            let disc = (qb * qb - 4.0 * qa * v).max(0.0).sqrt();
+            let (r1, r2) = ((-qb + disc) / (2.0 * qa), (-qb - disc) / (2.0 * qa));
+            let span = (k1 - k0) as f64;
+            if (0.0..=span).contains(&r1) {
+                r1
             } else {
-                hi = mid;
+                r2
             }
+        };
+        let on_side = |k: u64| at(k).map(|s| s.v.signum() == side);
+        let mut k = if m.is_finite() {
+            (k0 + m.max(0.0) as u64).clamp(k0, k1 - 1)
+        } else {
+            k0
+        };
+        while k > k0 && !on_side(k)? {
+            k -= 1;
         }
-        lo
+        while k + 1 < k1 && on_side(k + 1)? {
+            k += 1;
+        }
+        k
     };
     let c = at(crossing)?;
     if crossing > k0 {

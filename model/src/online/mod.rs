@@ -166,7 +166,9 @@ fn raw_limits(
     order: OnlineOrder,
     format: &Format,
 ) -> Result<RawLimits, OnlineError> {
-    let one = |name, value: f64, q: Quantity| -> Result<i128, OnlineError> {
+    // The raw limit, exact, and as a real (kept, not converted back: a 128-bit conversion is
+    // a library call).
+    let one = |name, value: f64, q: Quantity| -> Result<(i128, f64), OnlineError> {
         let bad = OnlineError::Limit { name, value };
         if !(value.is_finite() && value > 0.0) {
             return Err(bad);
@@ -176,25 +178,29 @@ fn raw_limits(
         if raw < 1.0 {
             return Err(bad);
         }
-        Ok(if raw >= cap as f64 { cap } else { raw as i128 })
+        Ok(if raw >= cap as f64 {
+            (cap, cap as f64)
+        } else {
+            (raw as i128, raw)
+        })
     };
     let v = one("velocity", l.velocity, Quantity::Velocity)?;
     let acc = one("acceleration", l.acceleration, Quantity::Acceleration)?;
     let dec = one("deceleration", l.deceleration, Quantity::Acceleration)?;
     let j = match order {
         OnlineOrder::Three => one("jerk", l.jerk, Quantity::Jerk)?,
-        OnlineOrder::Two => i128::MAX,
+        OnlineOrder::Two => (i128::MAX, i128::MAX as f64),
     };
     Ok(RawLimits {
-        v,
-        acc,
-        dec,
-        j,
+        v: v.0,
+        acc: acc.0,
+        dec: dec.0,
+        j: j.0,
         tick: TickLimits {
-            v: v as f64,
-            acc: acc as f64,
-            dec: dec as f64,
-            j: j as f64,
+            v: v.1,
+            acc: acc.1,
+            dec: dec.1,
+            j: j.1,
         },
     })
 }

@@ -148,7 +148,7 @@ impl Ctx<'_> {
             d_lo - x,
             (hi - lo).sqrt(),
             d_hi - x,
-            1e-12 * x.abs(),
+            1e-9 * x.abs(),
         );
         (lo + u * u).min(hi)
     }
@@ -338,7 +338,7 @@ pub fn plan(
     if d_max <= x {
         return Some(through(Branch::Cruise, vmax, (x - d_max) / vmax));
     }
-    let tol = 1e-12 * x.abs();
+    let tol = 1e-9 * x.abs();
     let lo = c.v_end.max(vi.min(vmax));
     let d_lo = c.d(lo);
     if d_lo <= x {
