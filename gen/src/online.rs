@@ -281,6 +281,19 @@ struct CommandJson {
     latency_ms: Option<f64>,
 }
 
+/// One override change's line in the JSON.
+#[derive(Serialize)]
+struct OverrideJson {
+    event: usize,
+    at_ms: f64,
+    /// The feed override (0–2).
+    factor: f64,
+    /// Refused (its ErrorID), or taken.
+    error_id: Option<String>,
+    /// Ticks from the event to the first tick that obeyed it (its swap), when it had one.
+    latency_ms: Option<f64>,
+}
+
 /// The registers, as decimal strings (they exceed 64 bits).
 #[derive(Serialize)]
 struct Raw {
@@ -294,6 +307,7 @@ struct Raw {
 #[derive(Serialize)]
 struct Json {
     commands: Vec<CommandJson>,
+    overrides: Vec<OverrideJson>,
     refused_overrides: Vec<(usize, String)>,
     replans: usize,
     extension_swaps: u32,
@@ -328,9 +342,43 @@ fn target_lsb(p: &Played) -> Option<i128> {
         })
 }
 
+/// The latency of event `k` (ms): from its due tick to the swap that realised it.
+fn latency_ms(p: &Played, k: usize) -> Option<f64> {
+    let r = &p.report;
+    let due = *r.event_ticks.get(k)?;
+    r.swaps
+        .iter()
+        .find(|s| s.events.contains(&k))
+        .map(|s| s.tick.saturating_sub(due) as f64 * r.axis.settings.format.ts * 1e3)
+}
+
+fn override_lines(p: &Played) -> Vec<OverrideJson> {
+    let r = &p.report;
+    let mut out = Vec::new();
+    for (k, e) in p.script.events.iter().enumerate() {
+        let Action::Override { r#override } = e.action else {
+            continue;
+        };
+        if r.event_ticks.get(k).is_none() {
+            continue;
+        }
+        out.push(OverrideJson {
+            event: k,
+            at_ms: e.at_ms,
+            factor: r#override,
+            error_id: r
+                .refused_overrides
+                .iter()
+                .find(|(ev, _)| *ev == k)
+                .map(|(_, id)| id.to_string()),
+            latency_ms: latency_ms(p, k),
+        });
+    }
+    out
+}
+
 fn command_lines(p: &Played) -> Vec<CommandJson> {
     let r = &p.report;
-    let ts = r.axis.settings.format.ts;
     let mut out = Vec::new();
     for (k, e) in p.script.events.iter().enumerate() {
         let Some(taken) = r.event_commands.get(k) else {
@@ -351,12 +399,7 @@ fn command_lines(p: &Played) -> Vec<CommandJson> {
             continue;
         };
         let rec = &r.axis.commands[*c];
-        let due = r.event_ticks[k];
-        let latency = r
-            .swaps
-            .iter()
-            .find(|s| s.events.contains(&k))
-            .map(|s| s.tick.saturating_sub(due) as f64 * ts * 1e3);
+        let latency = latency_ms(p, k);
         out.push(CommandJson {
             event: k,
             at_ms: e.at_ms,
@@ -379,6 +422,7 @@ pub fn json(p: &Played) -> String {
     let f = r.axis.settings.format;
     let j = Json {
         commands: command_lines(p),
+        overrides: override_lines(p),
         refused_overrides: r
             .refused_overrides
             .iter()
@@ -422,8 +466,18 @@ pub fn describe(p: &Played) -> String {
             c.note.map_or(String::new(), |n| format!(" ({n})")),
         );
     }
-    for (e, id) in &r.refused_overrides {
-        s += &format!("  event {e:>2}: override refused: {id}\n");
+    for o in override_lines(p) {
+        s += &format!(
+            "  event {:>2} at {:>8.1} ms  override {:<7} {}\n",
+            o.event,
+            o.at_ms,
+            format!("{:.0} %", o.factor * 100.0),
+            match (&o.error_id, o.latency_ms) {
+                (Some(id), _) => format!("refused: {id}"),
+                (None, Some(l)) => format!("latency {l:.2} ms"),
+                (None, None) => "nothing to change".into(),
+            }
+        );
     }
     s += &format!(
         "  {} replans ({} more swaps to upload long programs), {} ticks ({:.3} s), {} board states checked bit for bit against the plan\n",

@@ -5,8 +5,9 @@
 //!   acceleration 4000 mm/s², deceleration 3000 mm/s², jerk 5000, 50 000 or 500 000 mm/s³
 //!   (`--jerk`, default 50 000). The paper gives the lengths and limits but not the set speeds
 //!   or when they change (they are only drawn): this script's set speeds are ours — 100 mm/s,
-//!   then 200, 50 and 150 mm/s — given as feed overrides of a 200 mm/s move, and the tangent
-//!   move blends in at the previous move's set speed (BlendingPrevious).
+//!   then 200, 50 and 150 mm/s, and 80 mm/s on the tangent move — given as feed overrides of
+//!   200 mm/s moves, and the tangent move blends in at the previous move's set speed
+//!   (BlendingPrevious).
 //! * `seed000-fig3`: the two MC_MoveAbsolute cases of seed 000's Figure 3 (the standard's
 //!   timing diagram): (a) the second block starts after the first has stopped, (b) it starts
 //!   while the first still moves (Aborting); both end on the same position. The figure has no
@@ -74,8 +75,9 @@ impl Scenario {
                         at(0.0, mv(400.0, 200.0, j, BufferMode::Aborting)),
                         feed(800.0, 1.0),
                         feed(1300.0, 0.25),
+                        feed(2000.0, 0.75),
                         Event {
-                            at_ms: 1300.0,
+                            at_ms: 2000.0,
                             at_position: Some(300.0),
                             action: Action::Command(mv(
                                 500.0,
@@ -84,7 +86,7 @@ impl Scenario {
                                 BufferMode::BlendingPrevious,
                             )),
                         },
-                        feed(2200.0, 0.75),
+                        feed(3000.0, 0.4),
                     ],
                 }
             }

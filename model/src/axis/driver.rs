@@ -103,8 +103,9 @@ pub struct RunReport {
     pub axis: HostAxis,
     /// Which command each event gave (None: an override).
     pub event_commands: Vec<Option<usize>>,
-    /// The tick each event was taken on (its time, or when its position was seen reached);
-    /// events never taken (a position not reached) are missing at the end.
+    /// The tick each event was due on: its time, or the tick the event before it was due if
+    /// later (events are taken in order), or the tick its position was seen reached; events
+    /// never taken (a position not reached) are missing at the end.
     pub event_ticks: Vec<u64>,
     /// Override events refused (event index, why).
     pub refused_overrides: Vec<(usize, AxisErrorId)>,
@@ -189,6 +190,18 @@ fn frame_bytes(c: &Command, f: &crate::format::Format) -> usize {
     c.to_frame(0, f).to_bytes().len()
 }
 
+/// The first upload's sizes a change tries, fewest first (segments; the last is the whole
+/// program memory): a head of the change goes up and is swapped to, the rest follows as
+/// extensions while it plays (docs/ONLINE.md, "Latency").
+const HEADS: [usize; 7] = [6, 8, 10, 12, 16, 24, usize::MAX];
+
+/// The first `n` segments of `p`.
+fn head(p: &Program, n: usize) -> Program {
+    Program {
+        segments: p.segments[..n.min(p.segments.len())].to_vec(),
+    }
+}
+
 /// SWAP_AT attempts before a command is given up as the link being too slow.
 const LATE_TRIES: u32 = 8;
 
@@ -207,6 +220,10 @@ struct Runner<'l, L: Link> {
     extensions: u32,
     /// Ticks between polls.
     poll_ticks: u64,
+    /// The host's clock when the last READ_STATE's reply had come.
+    polled: f64,
+    /// That reply's ticks on the wire.
+    reply_wire: f64,
 }
 
 impl<L: Link> Runner<'_, L> {
@@ -214,10 +231,13 @@ impl<L: Link> Runner<'_, L> {
     fn poll(&mut self) -> Result<StateReply, RunError> {
         let t0 = self.link.host_ticks();
         let s = read_state(self.link)?;
-        let wire = (frame_bytes(&Command::ReadState, &self.axis.settings.format)
-            + Reply::State(s).to_frame(0).to_bytes().len()) as f64
-            * self.link.byte_ticks();
-        self.overhead = self.overhead.max(self.link.host_ticks() - t0 - wire);
+        self.polled = self.link.host_ticks();
+        self.reply_wire =
+            Reply::State(s).to_frame(0).to_bytes().len() as f64 * self.link.byte_ticks();
+        let wire = frame_bytes(&Command::ReadState, &self.axis.settings.format) as f64
+            * self.link.byte_ticks()
+            + self.reply_wire;
+        self.overhead = self.overhead.max(self.polled - t0 - wire);
         let want = self
             .axis
             .timeline
@@ -271,32 +291,51 @@ impl<L: Link> Runner<'_, L> {
                 self.poll()?;
                 continue;
             }
-            let now = self.poll()?.ticks;
+            if late_retries > 0 {
+                // Late: the board's clock read again. Otherwise the last poll (the run loop's,
+                // which found the change due) dates the board's tick.
+                self.poll()?;
+            }
+            let now = self.board_now();
             let f = self.axis.settings.format;
-            // The lead: the upload's time on the wire and the link's measured overhead per
-            // request, with a margin; planned again while the program found needs more.
-            let mut guess = self.axis.timeline.program_from(now, &f);
-            let mut tries = 0;
-            let (at, c, refused) = loop {
-                let lead = (self.upload_ticks(&guess) * 1.25 * margin).ceil() as u64 + SAFETY;
-                let at = now + lead;
-                tries += 1;
-                match self.axis.plan_batch(at, reqs) {
-                    (None, refused) => return Ok((None, refused)),
-                    (Some(c), refused) => {
-                        if self.upload_ticks(&c.program) * 1.25 * margin <= (lead - SAFETY) as f64
-                            || tries == 4
-                        {
-                            break (at, c, refused);
+            // The first upload carries the change's first segments only, as few as let the
+            // rest follow in time (`coverable`): the swap's lead, and so the latency, is that
+            // upload's; the rest goes up as extensions while the first part plays.
+            let mut found = None;
+            for first in HEADS {
+                let first = first.min(f.max_segments);
+                // The lead is the head's upload ([`Runner::lead`]); planned again while the
+                // program found needs a longer head than guessed.
+                let mut guess = first.min(self.axis.timeline.program_from(now, &f).segments.len());
+                let mut tries = 0;
+                let (at, c, refused) = loop {
+                    let at = now + self.lead(guess, margin);
+                    tries += 1;
+                    match self.axis.plan_batch(at, reqs) {
+                        (None, refused) => return Ok((None, refused)),
+                        (Some(c), refused) => {
+                            let up = first.min(c.program.segments.len());
+                            if up <= guess || tries == 4 {
+                                break (at, c, refused);
+                            }
+                            guess = up;
                         }
-                        guess = c.program;
                     }
+                };
+                let keeps = self.coverable(&c.timeline, at, margin, first);
+                if (keeps && self.roomy(&c.timeline, at, first)) || first >= f.max_segments {
+                    found = Some((at, c, refused, first, keeps));
+                    break;
                 }
+            }
+            let Some((at, c, refused, first, keeps)) = found else {
+                unreachable!("the last head is the whole program memory");
             };
-            if at >= self.covered && self.needs_extension() {
-                // The board would play out what it holds before this swap: upload the rest
-                // of the running change first (its swap is then waited for above).
-                self.extend()?;
+            if self.needs_extension() && !self.extension_fits(at, 1) {
+                // The board would play out what it holds before this swap, or before the rest
+                // of the running change could follow a NAK LATE of it (taken, the change makes
+                // that rest moot): upload that rest first (its swap is then waited for above).
+                self.extend(true)?;
                 continue;
             }
             if c.program.segments.is_empty() {
@@ -304,7 +343,7 @@ impl<L: Link> Runner<'_, L> {
                 self.axis.apply(c);
                 return Ok((None, refused));
             }
-            if !self.coverable(&c.timeline, at, margin) {
+            if !keeps {
                 // Taken, the change would leave the board without program: refused whole,
                 // nothing changes on the board.
                 let error = AxisErrorId::LinkTooSlow {
@@ -328,9 +367,10 @@ impl<L: Link> Runner<'_, L> {
                 }
                 return Ok((None, all));
             }
-            match self.arm(at, &c.program)? {
+            let upload = head(&c.program, first);
+            match self.arm(at, &upload)? {
                 Ok(()) => {
-                    let segments = c.program.segments.len();
+                    let segments = upload.segments.len();
                     self.axis.apply(c);
                     let record = SwapRecord {
                         events: events.to_vec(),
@@ -362,6 +402,7 @@ impl<L: Link> Runner<'_, L> {
             what,
             detail: reason.name().to_string(),
         };
+        let t0 = self.link.host_ticks();
         for (k, s) in program.segments.iter().enumerate() {
             let cmd = Command::LoadSegment {
                 index: k as u8,
@@ -373,7 +414,13 @@ impl<L: Link> Runner<'_, L> {
         let count = program.segments.len() as u8;
         self.expect_ack(&Command::Commit { count })?
             .map_err(|r| refused("COMMIT", r))?;
-        match self.expect_ack(&Command::SwapAt { tick: at })? {
+        let swap = self.expect_ack(&Command::SwapAt { tick: at })?;
+        // The overhead per request, as this upload measured it (a board may answer a
+        // LOAD_SEGMENT slower than a READ_STATE).
+        let n = program.segments.len();
+        let extra = (self.link.host_ticks() - t0 - self.upload_wire(n)) / (n + 2) as f64;
+        self.overhead = self.overhead.max(extra);
+        match swap {
             Ok(()) => {
                 self.armed = Some(at);
                 self.covered = at + program.total_ticks();
@@ -395,24 +442,30 @@ impl<L: Link> Runner<'_, L> {
             .is_empty()
     }
 
-    /// Whether `timeline`, swapped to at `at`, can be kept on the board: each upload of at
-    /// most the program memory must be followed, once its swap has passed and been seen
+    /// Whether `timeline`, swapped to at `at` with its first `first` segments, can be kept on
+    /// the board: that upload, and each later one of at most the program memory, must be
+    /// followed, once its swap has passed and been seen
     /// ([`Runner::seen_ticks`] later), by the upload of the rest (as [`Runner::extend`] leads
     /// it) armed before the board has played what it holds.
-    fn coverable(&self, timeline: &super::Timeline, at: u64, margin: f64) -> bool {
+    fn coverable(&self, timeline: &super::Timeline, at: u64, margin: f64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let mut swap = at;
+        let mut most = first.min(f.max_segments);
         loop {
             let rest = timeline.segments_from(swap, &f);
-            if rest.len() <= f.max_segments {
+            if rest.len() <= most {
                 return true;
             }
             let held = Program {
-                segments: rest[..f.max_segments].to_vec(),
+                segments: rest[..most].to_vec(),
             };
+            most = f.max_segments;
             let covered = swap + held.total_ticks();
-            let lead = (self.upload_ticks(&held) * 1.25 * margin).ceil() as u64 + SAFETY;
-            let next = swap + self.seen_ticks() + lead;
+            // The next upload: what is left once the swap has been seen (at most; later, less
+            // is left), at most the program memory.
+            let seen = swap + self.seen_ticks();
+            let left = timeline.segments_from(seen, &f).len().min(most);
+            let next = seen + self.lead(left, margin);
             if next >= covered {
                 return false;
             }
@@ -420,25 +473,59 @@ impl<L: Link> Runner<'_, L> {
         }
     }
 
+    /// Whether a head of `first` segments of `timeline`, swapped to at `at`, leaves the
+    /// standby bank free long enough: the upload of the rest can wait (as
+    /// [`Runner::can_defer_extension`] says) for as long as another such head takes to go up,
+    /// so a command that comes meanwhile does not wait behind it. A head of the whole change
+    /// always does.
+    fn roomy(&self, timeline: &super::Timeline, at: u64, first: usize) -> bool {
+        let f = self.axis.settings.format;
+        let rest = timeline.segments_from(at, &f);
+        if rest.len() <= first {
+            return true;
+        }
+        let covered = at
+            + rest[..first]
+                .iter()
+                .map(|s| u64::from(s.ticks))
+                .sum::<u64>();
+        let seen = at + self.seen_ticks();
+        let left = timeline.segments_from(seen, &f).len().min(f.max_segments);
+        seen + 3 * self.lead(left, 1.0) + self.lead(first, 1.0) < covered
+    }
+
+    /// Whether the upload of the rest of the running change (longer than the program memory)
+    /// can wait past `tick`: a poll after it could still arm it, and arm it again with twice
+    /// the lead after a NAK LATE.
+    fn can_defer_extension(&self, tick: u64) -> bool {
+        self.extension_fits(tick, 3)
+    }
+
+    /// Whether the rest of the running change, uploaded a poll after `tick` with `leads` times
+    /// its lead, is armed before the board has played what it holds.
+    fn extension_fits(&self, tick: u64, leads: u64) -> bool {
+        let f = self.axis.settings.format;
+        let left = self.axis.timeline.program_from(tick, &f).segments.len();
+        tick + self.seen_ticks() + leads * self.lead(left, 1.0) < self.covered
+    }
+
     /// When the timeline goes on past the program the board holds (a change longer than
-    /// the program memory), uploads the rest and swaps to it before the board's ends.
-    fn extend(&mut self) -> Result<(), RunError> {
+    /// the program memory), uploads the rest and swaps to it before the board's ends: at
+    /// once when `now`, else when it can wait no longer ([`Runner::can_defer_extension`]),
+    /// the standby bank free meanwhile (a change that comes makes this upload moot).
+    fn extend(&mut self, now: bool) -> Result<(), RunError> {
         let f = self.axis.settings.format;
         let mut margin = 1.0;
         for _ in 0..LATE_TRIES {
-            if self.armed.is_some()
-                || self
-                    .axis
-                    .timeline
-                    .program_from(self.covered, &f)
-                    .segments
-                    .is_empty()
-            {
+            if self.armed.is_some() || !self.needs_extension() {
                 return Ok(());
             }
-            let now = self.last.ticks;
-            let full = self.axis.timeline.program_from(now, &f);
-            let at = now + (self.upload_ticks(&full) * 1.25 * margin).ceil() as u64 + SAFETY;
+            let tick = self.board_now();
+            if !now && margin == 1.0 && self.can_defer_extension(tick) {
+                return Ok(());
+            }
+            let left = self.axis.timeline.program_from(tick, &f).segments.len();
+            let at = tick + self.lead(left, margin);
             if at >= self.covered {
                 return Err(too_slow());
             }
@@ -453,6 +540,13 @@ impl<L: Link> Runner<'_, L> {
         Err(too_slow())
     }
 
+    /// The board's tick now, as the host knows it: the last READ_STATE's tick, and the ticks
+    /// since (its reply's time on the wire, and the host's clock since it came).
+    fn board_now(&self) -> u64 {
+        let since = self.reply_wire + (self.link.host_ticks() - self.polled).max(0.0);
+        self.last.ticks + since.ceil() as u64
+    }
+
     /// Host ticks from a swap to the end of the poll that sees it has passed, at the most: a
     /// poll period, and two READ_STATE round trips (the one under way when the swap passes
     /// reads the tick before it).
@@ -464,25 +558,32 @@ impl<L: Link> Runner<'_, L> {
         self.poll_ticks + (2.0 * round_trip).ceil() as u64
     }
 
-    /// Host ticks the upload of `p` takes: LOAD_SEGMENTs, COMMIT and SWAP_AT with their
-    /// acknowledgements on the wire, and the measured overhead per request.
-    fn upload_ticks(&self, p: &crate::program::Program) -> f64 {
+    /// Host ticks the upload of `n` segments takes: LOAD_SEGMENTs, COMMIT and SWAP_AT with
+    /// their acknowledgements on the wire ([`Runner::upload_wire`]), and the measured overhead
+    /// per request.
+    fn upload_ticks(&self, n: usize) -> f64 {
+        self.upload_wire(n) + (n + 2) as f64 * self.overhead
+    }
+
+    /// Host ticks the frames of an upload of `n` segments take on the wire.
+    fn upload_wire(&self, n: usize) -> f64 {
         let f = &self.axis.settings.format;
         let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
-        let load = p.segments.first().map_or(0, |s| {
-            frame_bytes(
-                &Command::LoadSegment {
-                    index: 0,
-                    segment: *s,
-                },
-                f,
-            )
-        });
+        let load = Command::LoadSegment {
+            index: 0,
+            segment: crate::program::Segment { ticks: 1, snap: 0 },
+        };
         let commit = frame_bytes(&Command::Commit { count: 0 }, f);
         let swap = frame_bytes(&Command::SwapAt { tick: 0 }, f);
-        let n = p.segments.len();
-        let bytes = n * (load + ack) + commit + swap + 2 * ack;
-        bytes as f64 * self.link.byte_ticks() + (n + 2) as f64 * self.overhead
+        let bytes = n * (frame_bytes(&load, f) + ack) + commit + swap + 2 * ack;
+        bytes as f64 * self.link.byte_ticks()
+    }
+
+    /// The lead a swap of an upload of `n` segments is armed with: its time
+    /// ([`Runner::upload_ticks`]) with a quarter more, times `margin` (doubled after each
+    /// NAK LATE), and [`SAFETY`].
+    fn lead(&self, n: usize, margin: f64) -> u64 {
+        (self.upload_ticks(n) * 1.25 * margin).ceil() as u64 + SAFETY
     }
 
     /// True when nothing will move any more without a new command.
@@ -519,6 +620,8 @@ pub fn run<L: Link>(
         covered: first.ticks,
         extensions: 0,
         poll_ticks: ticks_of(opts.poll_ms, ts).max(1),
+        polled: 0.0,
+        reply_wire: 0.0,
     };
     let start = first.ticks;
     let f = settings.format;
@@ -536,35 +639,37 @@ pub fn run<L: Link>(
     let end_by = last_due + ticks_of(opts.settle_ms, ts);
     loop {
         let now = r.poll()?.ticks;
-        r.extend()?;
+        r.extend(false)?;
         let here = f.position_physical(r.last.x);
-        let due_by = |e: &Event| {
+        let is_due = |e: &Event| {
             let reached = e.at_position.is_none_or(|p| {
                 let toward = (p - home).signum();
                 (here - p) * toward >= 0.0
             });
-            (start + ticks_of(e.at_ms, ts) <= now && reached).then_some(now)
+            start + ticks_of(e.at_ms, ts) <= now && reached
         };
         if let Some(e) = script.get(next) {
-            if let Some(due) = due_by(e) {
-                // Every event due by now, planned together; a position trigger is due on the
-                // tick it was seen reached.
-                let due = if e.at_position.is_some() {
-                    due
-                } else {
-                    start + ticks_of(e.at_ms, ts)
+            if is_due(e) {
+                // Every event due by now, planned together. Events are taken in order: one is
+                // due at its time, or when the event before it was due if that is later (held
+                // back behind a position trigger); a position trigger is due on the tick it was
+                // seen reached.
+                let released = |e: &Event, before: u64| {
+                    if e.at_position.is_some() {
+                        now
+                    } else {
+                        (start + ticks_of(e.at_ms, ts)).max(before)
+                    }
                 };
+                let due = released(e, event_ticks.last().copied().unwrap_or(start));
                 let first = next;
                 let mut reqs = Vec::new();
                 while let Some(e) = script.get(next) {
-                    if due_by(e).is_none() {
+                    if !is_due(e) {
                         break;
                     }
-                    event_ticks.push(if e.at_position.is_some() {
-                        now
-                    } else {
-                        start + ticks_of(e.at_ms, ts)
-                    });
+                    let before = event_ticks.last().copied().unwrap_or(start);
+                    event_ticks.push(released(e, before));
                     match e.action {
                         Action::Command(c) => {
                             let k = r.axis.submit(c);
