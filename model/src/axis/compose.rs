@@ -74,9 +74,12 @@ impl HostAxis {
     /// previous move is in at `at` falls back to Buffered (the previous move unchanged; the
     /// command's note says so).
     pub fn plan_change(&self, at: u64, req: Request) -> Result<Change, Refusal> {
-        match self.plan_change_with(at, req, true) {
+        if let Request::Override(k) = req {
+            return self.plan_override(at, k);
+        }
+        match self.plan_change_with(at, req, true, false) {
             Err(_) if self.blends(req) => {
-                let mut c = self.plan_change_with(at, req, false)?;
+                let mut c = self.plan_change_with(at, req, false, false)?;
                 if let Request::Command(k) = req {
                     c.notes.push((
                         k,
@@ -90,6 +93,71 @@ impl HostAxis {
         }
     }
 
+    /// An override to factor `k` from tick `at`: the parts from `at` replanned with it, unless
+    /// the move playing at `at` only slows down from there (its final brake), the new set
+    /// speed is not below the speed it slows from, and the replanned move would not end sooner
+    /// (the path left is too short to go faster; a replan from such a state may have to stop
+    /// and go again): then that move plays on as planned and only the ones after it are
+    /// replanned.
+    fn plan_override(&self, at: u64, k: f64) -> Result<Change, Refusal> {
+        let replanned = self.plan_change_with(at, Request::Override(k), false, false);
+        let Some(p) = self.timeline.parts.iter().find(|p| p.end_tick() > at) else {
+            return replanned;
+        };
+        let keeps = k > 0.0
+            && self.slows_to_its_end(p, at)
+            && matches!(self.commands[p.command].command,
+                MotionCommand::MoveAbsolute { velocity, .. } if velocity * k >= self.speed_at(at));
+        if !keeps {
+            return replanned;
+        }
+        let ends = |c: &Change| {
+            c.timeline
+                .parts
+                .iter()
+                .find(|q| q.command == p.command && q.end_tick() > at)
+                .map_or(0, |q| q.end_tick())
+        };
+        match replanned {
+            Ok(c) if ends(&c) < p.end_tick() => Ok(c),
+            _ => self.plan_change_with(at, Request::Override(k), false, true),
+        }
+    }
+
+    /// True when part `p` (a move to a position) only slows down from tick `at` to its end:
+    /// moving at `at`, its acceleration never along the motion and its velocity never crossing
+    /// zero before its end. The acceleration is linear between segment ends (orders 2 and 3),
+    /// so the segment ends decide.
+    fn slows_to_its_end(&self, p: &Part, at: u64) -> bool {
+        let f = &self.settings.format;
+        if !matches!(p.goal, Goal::Position { .. }) || p.start_tick >= at || p.end_tick() <= at {
+            return false;
+        }
+        let now = self.timeline.state_at(at, f);
+        let dir = now.v.signum();
+        if dir == 0 || now.a * dir > 0 {
+            return false;
+        }
+        let mut tick = p.start_tick;
+        for s in &p.program.segments {
+            tick += u64::from(s.ticks);
+            if tick <= at || tick >= p.end_tick() {
+                continue;
+            }
+            let b = self.timeline.state_at(tick, f);
+            if b.v * dir <= 0 || b.a * dir > 0 {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The speed at tick `at` (unit/s).
+    fn speed_at(&self, at: u64) -> f64 {
+        let f = &self.settings.format;
+        f.to_physical(Quantity::Velocity, self.timeline.state_at(at, f).v.abs())
+    }
+
     /// True when `req` is a blending move.
     fn blends(&self, req: Request) -> bool {
         matches!(req, Request::Command(k) if !matches!(
@@ -98,7 +166,13 @@ impl HostAxis {
         ))
     }
 
-    fn plan_change_with(&self, at: u64, req: Request, blend: bool) -> Result<Change, Refusal> {
+    fn plan_change_with(
+        &self,
+        at: u64,
+        req: Request,
+        blend: bool,
+        keep_playing: bool,
+    ) -> Result<Change, Refusal> {
         let f = &self.settings.format;
         let mut k = self.override_factor;
         let mut live = self.live(at);
@@ -124,6 +198,9 @@ impl HostAxis {
                 }
                 k = f;
                 keep = playing_from;
+                if keep_playing {
+                    keep = playing_from + 1;
+                }
             }
             Request::Command(new) => {
                 let cmd = self.commands[new].command;
@@ -545,5 +622,105 @@ impl HostAxis {
             override_factor: work.override_factor,
         };
         (Some(change), refused)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::axis::AxisSettings;
+    use crate::online::OnlineOrder;
+    use crate::DEFAULT_FORMAT;
+
+    fn mv(position: f64, velocity: f64) -> MotionCommand {
+        MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration: 4000.0,
+            deceleration: 3000.0,
+            jerk: 200_000.0,
+            buffer_mode: BufferMode::Aborting,
+        }
+    }
+
+    /// An axis that has started a move to `position` at `velocity` on tick 0.
+    fn moving(order: OnlineOrder, position: f64, velocity: f64) -> HostAxis {
+        let f = DEFAULT_FORMAT;
+        let settings = AxisSettings { format: f, order };
+        let mut axis = HostAxis::new(settings, 0, ChainState::at_rest(f.home_raw()));
+        let k = axis.submit(mv(position, velocity));
+        let (c, refused) = axis.plan_batch(0, &[Request::Command(k)]);
+        assert!(refused.is_empty());
+        axis.apply(c.unwrap());
+        axis
+    }
+
+    /// The velocity on every tick of `t` from `from` to its end (raw).
+    fn velocities(t: &Timeline, from: u64) -> Vec<i128> {
+        let f = DEFAULT_FORMAT;
+        (from..t.end_tick()).map(|k| t.state_at(k, &f).v).collect()
+    }
+
+    /// A tick a third of the way into the move's final brake (from the last tick at its top
+    /// speed to its end), and the speed there (raw).
+    fn in_final_brake(axis: &HostAxis) -> (u64, i128) {
+        let v = velocities(&axis.timeline, 0);
+        let top = v.iter().map(|v| v.abs()).max().unwrap();
+        let k = v.iter().rposition(|v| v.abs() == top).unwrap();
+        let at = k + (v.len() - k) / 3;
+        (at as u64, v[at].abs())
+    }
+
+    #[test]
+    fn an_override_raised_during_the_final_brake_keeps_the_brake() {
+        for order in [OnlineOrder::Three, OnlineOrder::Two] {
+            let axis = moving(order, 20.0, 200.0);
+            let (at, speed) = in_final_brake(&axis);
+            let speed = DEFAULT_FORMAT.to_physical(Quantity::Velocity, speed);
+            assert!(speed > 20.0, "{order:?}: {speed} at {at}");
+            let (c, refused) = axis.plan_batch(at, &[Request::Override(2.0)]);
+            assert!(refused.is_empty());
+            let c = c.unwrap();
+            assert!(
+                velocities(&c.timeline, at) == velocities(&axis.timeline, at),
+                "{order:?}: the brake changed"
+            );
+            // Asking for less than the speed it brakes from replans it: slower from there on.
+            let (c, _) = axis.plan_batch(at, &[Request::Override(0.1 * speed / 200.0)]);
+            let (old, new) = (
+                velocities(&axis.timeline, at),
+                velocities(&c.unwrap().timeline, at),
+            );
+            assert!(
+                new.len() > old.len(),
+                "{order:?}: a cut did not slow the brake"
+            );
+        }
+    }
+
+    #[test]
+    fn an_override_raised_while_slowing_to_a_lower_cruise_speeds_up() {
+        for order in [OnlineOrder::Three, OnlineOrder::Two] {
+            let mut axis = moving(order, 100.0, 200.0);
+            // At cruise, cut to 10 %; then, while it slows down, back to 100 %.
+            let cruise = axis.timeline.end_tick() / 3;
+            let (c, _) = axis.plan_batch(cruise, &[Request::Override(0.1)]);
+            axis.apply(c.unwrap());
+            let at = cruise + 500;
+            let v = velocities(&axis.timeline, at);
+            assert!(
+                v[0].abs() > v[1].abs(),
+                "{order:?}: not slowing down at {at}"
+            );
+            let (c, refused) = axis.plan_batch(at, &[Request::Override(1.0)]);
+            assert!(refused.is_empty());
+            let new = velocities(&c.unwrap().timeline, at);
+            assert!(
+                new.len() < v.len(),
+                "{order:?}: raised again, the move did not end sooner ({} ticks, was {})",
+                new.len(),
+                v.len()
+            );
+        }
     }
 }
