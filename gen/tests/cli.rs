@@ -562,6 +562,16 @@ fn online_plays_a_script_and_reports_every_field() {
         .map(|c| c["outcome"].as_str().unwrap())
         .collect();
     assert_eq!(outcomes, ["Done", "Done"]);
+    // The override: taken, with its latency (at 3 Mbaud its own upload, and here the one it
+    // waited for: the blend's, still on the wire).
+    let overrides = j["overrides"].as_array().unwrap();
+    assert_eq!(overrides.len(), 1);
+    assert_eq!(overrides[0]["event"], 2);
+    assert_eq!(overrides[0]["factor"], 0.5);
+    assert!(overrides[0]["error_id"].is_null());
+    let ms = overrides[0]["latency_ms"].as_f64().unwrap();
+    assert!(ms > 0.0 && ms < 10.0, "override latency {ms} ms");
+    assert!(j["refused_overrides"].as_array().unwrap().is_empty());
     assert!(j["replans"].as_u64().unwrap() >= 1);
     assert_eq!(j["final_lsb"], j["target_lsb"]);
     assert_eq!(j["target_lsb"].as_i64(), Some(5_000_000));

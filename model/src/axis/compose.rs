@@ -533,23 +533,67 @@ fn plan_part(
                 ..l
             };
             let at = |v: f64| OnlineTarget::Position { cell, velocity: v };
+            // The blend given up: to rest on the target, the next move from there.
+            let buffered = || {
+                let (p, e) = run(at(0.0), l)?;
+                Ok((
+                    p,
+                    e,
+                    Goal::Position {
+                        cell,
+                        velocity: 0.0,
+                    },
+                    false,
+                    Some("blend not reachable before the blend point: buffered instead".into()),
+                ))
+            };
+            let blend = |v: f64| {
+                let l = OnlineLimits {
+                    velocity: l.velocity.max(v.abs()),
+                    ..l
+                };
+                run(at(v), l)
+            };
             match run(at(vb), l) {
                 Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
-                Err(OnlineError::BlendUnreachable) | Err(OnlineError::NotRealisable(_))
-                    if vb != 0.0 =>
-                {
-                    let (p, e) = run(at(0.0), l)?;
-                    Ok((
-                        p,
-                        e,
-                        Goal::Position {
-                            cell,
-                            velocity: 0.0,
-                        },
-                        false,
-                        Some("blend not reachable before the blend point: buffered instead".into()),
-                    ))
+                Err(OnlineError::BlendUnreachable) if vb != 0.0 => {
+                    // Too fast to slow to the blend velocity by the blend point (an override
+                    // cut on a short move): the lowest blend velocity up to the speed now that
+                    // can be reached, found to 1/64 of the way; else as buffered.
+                    let now = f.to_physical(Quantity::Velocity, from.v.abs());
+                    let mut hi = now.max(vb.abs());
+                    let mut found = blend(hi * vb.signum()).ok().map(|r| (hi, r));
+                    if found.is_some() {
+                        let mut lo = vb.abs();
+                        for _ in 0..6 {
+                            let mid = 0.5 * (lo + hi);
+                            match blend(mid * vb.signum()) {
+                                Ok(r) => {
+                                    hi = mid;
+                                    found = Some((mid, r));
+                                }
+                                Err(_) => lo = mid,
+                            }
+                        }
+                    }
+                    match found {
+                        Some((v, (p, e))) => Ok((
+                            p,
+                            e,
+                            Goal::Position {
+                                cell,
+                                velocity: v * vb.signum(),
+                            },
+                            false,
+                            Some(format!(
+                                "the blend velocity {:.3} could not be reached before the blend point: passed at {v:.3} instead",
+                                vb.abs()
+                            )),
+                        )),
+                        None => buffered(),
+                    }
                 }
+                Err(OnlineError::NotRealisable(_)) if vb != 0.0 => buffered(),
                 Err(e) => Err(e),
             }
         }
@@ -696,6 +740,66 @@ mod tests {
                 "{order:?}: a cut did not slow the brake"
             );
         }
+    }
+
+    /// An override cut on a short blended move that leaves it too fast to slow to the new
+    /// blend velocity by the blend point: it passes the point at the lowest velocity it can
+    /// (not at rest, as a buffered move would), exactly, and the next move goes on from there.
+    #[test]
+    fn a_blend_velocity_an_override_cut_puts_out_of_reach_is_raised_not_dropped() {
+        let f = DEFAULT_FORMAT;
+        let settings = AxisSettings {
+            format: f,
+            order: OnlineOrder::Three,
+        };
+        let mut axis = HostAxis::new(settings, 0, ChainState::at_rest(f.home_raw()));
+        let move_to = |position, velocity, buffer_mode| MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration: 4000.0,
+            deceleration: 3000.0,
+            jerk: 500_000.0,
+            buffer_mode,
+        };
+        let first = axis.submit(move_to(3.0, 100.0, BufferMode::Aborting));
+        let next = axis.submit(move_to(5.0, 60.0, BufferMode::BlendingLow));
+        let (c, _) = axis.plan_batch(0, &[Request::Command(first), Request::Command(next)]);
+        axis.apply(c.unwrap());
+        // 25 ms in, at about 77 mm/s and still accelerating: 50 % asks for a blend at 30 mm/s,
+        // which braking from there cannot reach by 3 mm.
+        let at = 2500;
+        let now = f.to_physical(Quantity::Velocity, axis.timeline.state_at(at, &f).v);
+        let (c, refused) = axis.plan_batch(at, &[Request::Override(0.5)]);
+        assert!(refused.is_empty());
+        let c = c.unwrap();
+        let note = &c.notes.iter().find(|(k, _)| *k == first).unwrap().1;
+        assert!(note.contains("passed at"), "{note}");
+        let part = c
+            .timeline
+            .parts
+            .iter()
+            .find(|p| p.command == first && !p.cut)
+            .unwrap();
+        let Goal::Position { velocity, .. } = part.goal else {
+            panic!("{:?}", part.goal)
+        };
+        assert!(velocity > 30.0 && velocity < now, "{velocity} (now {now})");
+        // Stepped tick by tick: on 3 mm at that velocity, a = j = 0.
+        let mut s = part.start;
+        for seg in &part.program.segments {
+            for _ in 0..seg.ticks {
+                s = s.step(seg.snap, &f.widths);
+            }
+        }
+        let v_raw = (velocity * f.scale(Quantity::Velocity)).round() as i128;
+        assert_eq!((s.v, s.a, s.j), (v_raw, 0, 0));
+        assert_eq!(f.output_lsb(s.x), 3_000_000);
+        // The next move goes on from there to 5 mm at rest.
+        let last = c.timeline.parts.last().unwrap();
+        assert_eq!(last.command, next);
+        assert_eq!(last.start, s);
+        assert!(last.end.is_at_rest());
+        assert_eq!(f.output_lsb(last.end.x), 5_000_000);
     }
 
     #[test]
