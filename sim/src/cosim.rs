@@ -922,13 +922,7 @@ fn replan_chain(
                 continue;
             }
             Err(e) => {
-                let kind = format!("{e:?}");
-                let kind = kind
-                    .split(['(', ' ', '{'])
-                    .next()
-                    .unwrap_or("?")
-                    .to_string();
-                *report.replans_refused.entry(kind).or_default() += 1;
+                *report.replans_refused.entry(kind_of(&e)).or_default() += 1;
                 continue;
             }
         };
@@ -1143,6 +1137,15 @@ pub fn run_model_only(cfg: &CosimConfig) -> CosimReport {
     }
     report.seconds = wall.elapsed().as_secs_f64();
     report
+}
+
+/// The name of an error's variant (its `Debug` up to the first field), a report's key.
+fn kind_of(e: &impl std::fmt::Debug) -> String {
+    let text = format!("{e:?}");
+    text.split(['(', ' ', '{'])
+        .next()
+        .unwrap_or("?")
+        .to_string()
 }
 
 #[cfg(test)]

@@ -476,14 +476,7 @@ fn random_scripts_land_where_the_plan_says() {
         let mut events = Vec::new();
         for _ in 0..6 {
             t += (rnd() * 60.0).floor();
-            let modes = [
-                BufferMode::Aborting,
-                BufferMode::Buffered,
-                BufferMode::BlendingLow,
-                BufferMode::BlendingPrevious,
-                BufferMode::BlendingNext,
-                BufferMode::BlendingHigh,
-            ];
+            let modes = BufferMode::ALL;
             let r = rnd();
             let action = if r < 0.55 {
                 let mode = modes[(rnd() * 6.0) as usize % 6];
@@ -528,12 +521,16 @@ fn random_scripts_land_where_the_plan_says() {
         let r = play(&events, OnlineOrder::Three);
         swaps += r.swaps.len();
         commands += r.axis.commands.len();
-        errors += r
-            .axis
-            .commands
-            .iter()
-            .filter(|c| matches!(c.outcome, Outcome::Error(_)))
-            .count();
+        for c in &r.axis.commands {
+            if let Outcome::Error(e) = &c.outcome {
+                errors += 1;
+                eprintln!("refused: {e}");
+                assert!(
+                    matches!(e, AxisErrorId::LinkTooSlow { .. }),
+                    "a command refused by more than the link: {e}"
+                );
+            }
+        }
         let (end, _, _) = replay(&r);
         let last = r.last;
         assert_eq!(
@@ -546,9 +543,9 @@ fn random_scripts_land_where_the_plan_says() {
     }
     eprintln!("{commands} commands, {swaps} swaps, {errors} refused");
     assert!(swaps >= 200, "{swaps} swaps");
-    // The online planner refuses some replans from states on its own trajectories (README,
-    // issue 10's open items): a refused command is an Error, never a wrong trajectory.
-    assert!(errors * 10 < commands, "{errors} of {commands} refused");
+    // Only a change the slow co-simulation link cannot upload in time is refused (measured:
+    // 2 of 334): an Error, and nothing changes on the board.
+    assert!(errors * 50 < commands, "{errors} of {commands} refused");
 }
 
 /// A change whose program is longer than the program memory goes up in several uploads; when

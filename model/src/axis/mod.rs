@@ -56,6 +56,18 @@ pub enum BufferMode {
     BlendingHigh,
 }
 
+impl BufferMode {
+    /// Every mode, in the standard's order.
+    pub const ALL: [BufferMode; 6] = [
+        BufferMode::Aborting,
+        BufferMode::Buffered,
+        BufferMode::BlendingLow,
+        BufferMode::BlendingPrevious,
+        BufferMode::BlendingNext,
+        BufferMode::BlendingHigh,
+    ];
+}
+
 /// A motion command (a function block's inputs). Units: the format's user unit and seconds.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]

@@ -4,28 +4,33 @@
 //! integer (§5 of docs/MODEL.md); from an arbitrary start the chain's own state adds a term no
 //! scale can absorb. The method here (docs/MODEL.md §11):
 //!
-//! 1. **Whole ticks.** Every piece of the continuous profile is rounded *up* to whole ticks
-//!    (seed 000 eq 3), jerk pieces and the cruise to at least one tick so that each keeps a free
-//!    level; a one-tick *settle* piece returns the highest derivative to zero at the end.
+//! 1. **Whole ticks.** Every piece of the continuous profile is rounded to whole ticks (the
+//!    planner decides how, `super::problem`), jerk pieces and the cruise to at least one tick
+//!    so that each keeps a free level; a one-tick *settle* piece returns the highest
+//!    derivative to zero at the end.
 //! 2. **Levels by a linear solve.** With the tick counts fixed, the chain is linear in the piece
 //!    levels, so the end state is `F = F₀ + M·p` (`F₀` the start state played with every free
 //!    level zero, `M`'s columns the unit levels played from rest). The free levels `p` solve
 //!    the end conditions: acceleration zero in the cruise and at the end, the end velocity,
 //!    the end position (position targets) — four equations, four levels for order 3; the
 //!    acceleration levels of order 2 make the acceleration exact by construction, leaving two.
-//! 3. **Integers, and one refinement.** The levels are rounded to integers, the program is
-//!    played exactly, and the exact residual is solved again (`M·δ = r`) and rounded: what is
-//!    left is the rounding of the levels, a few raw LSBs of acceleration and velocity.
-//! 4. **The unimodular tail.** Three one-tick snap impulses `s₁, s₂, s₃` take any residual
-//!    `(v, a)` with `j = 0` to exactly `(V, 0, 0)`:
-//!    `v₃ = v + 3a + s₁`, `a₃ = a + 2s₁ + s₂`, `j₃ = s₁ + s₂ + s₃`. The matrix
+//!    `M` is factored once (LU).
+//! 3. **Integers, and refinements.** The levels are rounded to integers, the program is
+//!    played exactly, and the exact residual is solved again (`M·δ = r`), rounded and added in
+//!    integers, up to twice (until the correction is zero): what is left is the rounding of
+//!    the levels, a few raw LSBs of acceleration and velocity.
+//! 4. **The unimodular tail.** Three one-tick snaps `s₁, s₂, s₃` take any residual
+//!    `(v, a, j)` to exactly `(V, 0, 0)`: `v₃ = v + 3a + 3j + s₁`,
+//!    `a₃ = a + 3j + 2s₁ + s₂`, `j₃ = j + s₁ + s₂ + s₃`. The matrix
 //!    `[[1,0,0],[2,1,0],[1,1,1]]` has determinant 1, so the integer solution
-//!    `s₁ = V − v − 3a`, `s₂ = −a − 2s₁`, `s₃ = −s₁ − s₂` always exists and is as small as the
-//!    residual. The position moves by a few residuals: far below half an output LSB.
+//!    `s₁ = V − v − 3a − 3j`, `s₂ = −a − 3j − 2s₁`, `s₃ = −j − s₁ − s₂` always exists and is as
+//!    small as the residual. The tail moves the position by `3v + 3a + j`, which the aim
+//!    includes.
 //!
 //! The result is checked, not assumed: the final state must be exactly the requested one and
-//! the position in the target cell, and the exact per-tick peaks of every segment
-//! ([`check_limits`]) must stay within the limits.
+//! the position in the target cell, and every tick must stay within the limits: exactly, a
+//! piece at a time (`check_pieces`; the segment-level [`check_limits`] is the reference the
+//! unit tests compare it with).
 //!
 //! Everything is computed a *piece* at a time in closed form (a piece: its jerk set on its
 //! first tick, held for the rest), in `f64` for the solve and in checked `i128` for the
@@ -912,8 +917,8 @@ fn check_from(
 /// before, whose acceleration shrinks |v|, have the deceleration limit; the tick whose
 /// acceleration takes the velocity through zero counts as both (the smaller limit); the ticks
 /// after, where |v| grows, the acceleration limit. So the part is split around that tick,
-/// found by bisection: exact, where one check of the whole part would apply the smaller limit
-/// to every tick.
+/// estimated from the velocity's quadratic in the tick and then made exact: where one check
+/// of the whole part would apply the smaller limit to every tick.
 fn check_part(
     caps: &Caps,
     cap: usize,

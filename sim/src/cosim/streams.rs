@@ -164,14 +164,7 @@ const BAUDS: [f64; 4] = [3e6, 3e6, 921_600.0, 115_200.0];
 /// `home` (Aborting) and the override back to 1, so that the stream ends at rest.
 fn script(rng: &mut StdRng, f: &Format, n: u8, home: f64) -> Vec<Event> {
     let ms = |ticks: f64| ticks * f.ts * 1e3;
-    let modes = [
-        BufferMode::Aborting,
-        BufferMode::Buffered,
-        BufferMode::BlendingLow,
-        BufferMode::BlendingPrevious,
-        BufferMode::BlendingNext,
-        BufferMode::BlendingHigh,
-    ];
+    let modes = BufferMode::ALL;
     let mut events = Vec::with_capacity(usize::from(n) + 2);
     let mut t = 0.0;
     let limits = |rng: &mut StdRng| {
@@ -324,13 +317,7 @@ fn tally(r: &RunReport, report: &mut CosimReport) {
     report.stream_commands += r.axis.commands.len();
     for c in &r.axis.commands {
         if let Outcome::Error(e) = &c.outcome {
-            let kind = format!("{e:?}");
-            let kind = kind
-                .split(['(', ' ', '{'])
-                .next()
-                .unwrap_or("?")
-                .to_string();
-            *report.stream_errors.entry(kind).or_default() += 1;
+            *report.stream_errors.entry(super::kind_of(e)).or_default() += 1;
         }
     }
     let want = r
