@@ -190,9 +190,41 @@ fn frame_bytes(c: &Command, f: &crate::format::Format) -> usize {
     c.to_frame(0, f).to_bytes().len()
 }
 
+/// The frames a run sends and reads, in bytes (fixed by the format: computed once).
+#[derive(Clone, Copy, Debug)]
+struct FrameBytes {
+    /// READ_STATE and its STATE reply.
+    read: usize,
+    /// The STATE reply alone.
+    state: usize,
+    /// One LOAD_SEGMENT and its ACK.
+    load: usize,
+    /// COMMIT, SWAP_AT and their ACKs.
+    arm: usize,
+}
+
+impl FrameBytes {
+    fn of(f: &crate::format::Format, s: StateReply) -> Self {
+        let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
+        let state = Reply::State(s).to_frame(0).to_bytes().len();
+        let load = Command::LoadSegment {
+            index: 0,
+            segment: crate::program::Segment { ticks: 1, snap: 0 },
+        };
+        FrameBytes {
+            read: frame_bytes(&Command::ReadState, f) + state,
+            state,
+            load: frame_bytes(&load, f) + ack,
+            arm: frame_bytes(&Command::Commit { count: 0 }, f)
+                + frame_bytes(&Command::SwapAt { tick: 0 }, f)
+                + 2 * ack,
+        }
+    }
+}
+
 /// The first upload's sizes a change tries, fewest first (segments; the last is the whole
 /// program memory): a head of the change goes up and is swapped to, the rest follows as
-/// extensions while it plays (docs/ONLINE.md, "Latency").
+/// extensions while it plays (docs/ONLINE.md, "How a change is made").
 const HEADS: [usize; 7] = [6, 8, 10, 12, 16, 24, usize::MAX];
 
 /// The first `n` segments of `p`.
@@ -224,6 +256,15 @@ struct Runner<'l, L: Link> {
     polled: f64,
     /// That reply's ticks on the wire.
     reply_wire: f64,
+    /// Host ticks the longest planning of a change took (0 on a virtual board, whose clock
+    /// stands still while the host computes).
+    planning: u64,
+    /// Frame sizes.
+    bytes: FrameBytes,
+    /// The last tick the upload of the rest of the running change may wait past
+    /// ([`Runner::defer_deadline`]), once found; cleared when the board's program or the
+    /// timeline changes.
+    defer_until: Option<u64>,
 }
 
 impl<L: Link> Runner<'_, L> {
@@ -232,11 +273,8 @@ impl<L: Link> Runner<'_, L> {
         let t0 = self.link.host_ticks();
         let s = read_state(self.link)?;
         self.polled = self.link.host_ticks();
-        self.reply_wire =
-            Reply::State(s).to_frame(0).to_bytes().len() as f64 * self.link.byte_ticks();
-        let wire = frame_bytes(&Command::ReadState, &self.axis.settings.format) as f64
-            * self.link.byte_ticks()
-            + self.reply_wire;
+        self.reply_wire = self.bytes.state as f64 * self.link.byte_ticks();
+        let wire = self.bytes.read as f64 * self.link.byte_ticks();
         self.overhead = self.overhead.max(self.polled - t0 - wire);
         let want = self
             .axis
@@ -284,7 +322,9 @@ impl<L: Link> Runner<'_, L> {
         loop {
             // An armed swap must have passed before the standby bank is written again.
             if let Some(t) = self.armed {
-                let now = self.poll()?.ticks;
+                // Waited for from the board's tick now (its last reply has come since), then
+                // seen a round trip later, as [`Runner::seen_ticks`] has it.
+                let now = self.board_now();
                 if now < t {
                     self.link.wait(t - now);
                 }
@@ -296,20 +336,25 @@ impl<L: Link> Runner<'_, L> {
                 // which found the change due) dates the board's tick.
                 self.poll()?;
             }
+            let t0 = self.link.host_ticks();
             let now = self.board_now();
             let f = self.axis.settings.format;
             // The first upload carries the change's first segments only, as few as let the
-            // rest follow in time (`coverable`): the swap's lead, and so the latency, is that
-            // upload's; the rest goes up as extensions while the first part plays.
+            // rest follow in time (`coverable`) and leave the standby bank free a while
+            // (`roomy`): the swap's lead, and so the latency, is that upload's; the rest goes
+            // up as extensions while the first part plays. A head that keeps the board going
+            // but is not roomy is taken when no larger one keeps it going.
             let mut found = None;
+            let mut fallback: Option<(u64, super::Change, Vec<(Request, Refusal)>, usize, bool)> =
+                None;
             for first in HEADS {
                 let first = first.min(f.max_segments);
-                // The lead is the head's upload ([`Runner::lead`]); planned again while the
-                // program found needs a longer head than guessed.
+                // The lead is the head's upload ([`Runner::lead`]) and the planning time seen;
+                // planned again while the program found needs a longer head than guessed.
                 let mut guess = first.min(self.axis.timeline.program_from(now, &f).segments.len());
                 let mut tries = 0;
                 let (at, c, refused) = loop {
-                    let at = now + self.lead(guess, margin);
+                    let at = now + self.lead(guess, margin) + self.planning;
                     tries += 1;
                     match self.axis.plan_batch(at, reqs) {
                         (None, refused) => return Ok((None, refused)),
@@ -322,16 +367,33 @@ impl<L: Link> Runner<'_, L> {
                         }
                     }
                 };
-                let keeps = self.coverable(&c.timeline, at, margin, first);
-                if (keeps && self.roomy(&c.timeline, at, first)) || first >= f.max_segments {
-                    found = Some((at, c, refused, first, keeps));
+                // A roomy head is worth at most twice the lead of the smallest one that keeps
+                // the board going.
+                if let Some((small, ..)) = &fallback {
+                    if at - now > 2 * (small - now) {
+                        break;
+                    }
+                }
+                let keeps = self.coverable(&c.timeline, at, first);
+                if keeps && self.roomy(&c.timeline, at, first) {
+                    found = Some((at, c, refused, first, true));
                     break;
                 }
+                if keeps && fallback.is_none() {
+                    fallback = Some((at, c, refused, first, true));
+                } else if first >= f.max_segments && fallback.is_none() {
+                    found = Some((at, c, refused, first, keeps));
+                }
             }
-            let Some((at, c, refused, first, keeps)) = found else {
-                unreachable!("the last head is the whole program memory");
+            let Some((at, c, refused, first, keeps)) = found.or(fallback) else {
+                unreachable!("the last head is the whole program memory, kept or not");
             };
-            if self.needs_extension() && !self.extension_fits(at, 1) {
+            // Planning takes host time a serial port's board does not wait for (a virtual
+            // board's clock stands still meanwhile): the longest seen goes into later leads.
+            self.planning = self
+                .planning
+                .max((self.link.host_ticks() - t0).max(0.0).ceil() as u64);
+            if self.needs_extension() && !self.extension_fits(at) {
                 // The board would play out what it holds before this swap, or before the rest
                 // of the running change could follow a NAK LATE of it (taken, the change makes
                 // that rest moot): upload that rest first (its swap is then waited for above).
@@ -341,6 +403,7 @@ impl<L: Link> Runner<'_, L> {
             if c.program.segments.is_empty() {
                 // Nothing plays from `at` (the axis rests before it): no swap is needed.
                 self.axis.apply(c);
+                self.defer_until = None;
                 return Ok((None, refused));
             }
             if !keeps {
@@ -424,6 +487,7 @@ impl<L: Link> Runner<'_, L> {
             Ok(()) => {
                 self.armed = Some(at);
                 self.covered = at + program.total_ticks();
+                self.defer_until = None;
                 Ok(Ok(()))
             }
             Err(Reason::Late) => Ok(Err(())),
@@ -447,7 +511,7 @@ impl<L: Link> Runner<'_, L> {
     /// followed, once its swap has passed and been seen
     /// ([`Runner::seen_ticks`] later), by the upload of the rest (as [`Runner::extend`] leads
     /// it) armed before the board has played what it holds.
-    fn coverable(&self, timeline: &super::Timeline, at: u64, margin: f64, first: usize) -> bool {
+    fn coverable(&self, timeline: &super::Timeline, at: u64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let mut swap = at;
         let mut most = first.min(f.max_segments);
@@ -465,7 +529,7 @@ impl<L: Link> Runner<'_, L> {
             // is left), at most the program memory.
             let seen = swap + self.seen_ticks();
             let left = timeline.segments_from(seen, &f).len().min(most);
-            let next = seen + self.lead(left, margin);
+            let next = seen + self.lead(left, 1.0);
             if next >= covered {
                 return false;
             }
@@ -474,10 +538,10 @@ impl<L: Link> Runner<'_, L> {
     }
 
     /// Whether a head of `first` segments of `timeline`, swapped to at `at`, leaves the
-    /// standby bank free long enough: the upload of the rest can wait (as
-    /// [`Runner::can_defer_extension`] says) for as long as another such head takes to go up,
-    /// so a command that comes meanwhile does not wait behind it. A head of the whole change
-    /// always does.
+    /// standby bank free long enough: the upload of the rest can wait (three of its leads
+    /// before the head ends, as [`Runner::defer_deadline`] has it) for as long as another such
+    /// head takes to go up, so a command that comes meanwhile does not wait behind it. A head
+    /// of the whole change always does.
     fn roomy(&self, timeline: &super::Timeline, at: u64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let rest = timeline.segments_from(at, &f);
@@ -494,25 +558,81 @@ impl<L: Link> Runner<'_, L> {
         seen + 3 * self.lead(left, 1.0) + self.lead(first, 1.0) < covered
     }
 
-    /// Whether the upload of the rest of the running change (longer than the program memory)
-    /// can wait past `tick`: a poll after it could still arm it, and arm it again with twice
-    /// the lead after a NAK LATE.
-    fn can_defer_extension(&self, tick: u64) -> bool {
-        self.extension_fits(tick, 3)
+    /// The last tick past which the upload of the rest of the running change can wait: the
+    /// board's program end less a poll and three leads of that upload (a NAK LATE and a retry
+    /// at twice the lead), when from there it still fits ([`Runner::extension_fits`]) and every
+    /// later upload still follows in time ([`Runner::coverable`] from the latest swap that
+    /// leaves); else `tick − 1`: at once.
+    fn defer_deadline(&self, tick: u64) -> u64 {
+        let f = self.axis.settings.format;
+        let at_once = tick.saturating_sub(1);
+        // What the upload will carry: from the segment playing then on, at most the program
+        // memory; first guessed as the rest after the board's program and one more, then
+        // counted from the deadline that guess gives (earlier: more), a few times.
+        let mut carried = self.axis.timeline.segments_from(self.covered, &f).len() + 1;
+        for _ in 0..4 {
+            let lead = self.lead(carried.min(f.max_segments), 1.0);
+            let Some(deadline) = self.covered.checked_sub(self.seen_ticks() + 3 * lead + 1) else {
+                return at_once;
+            };
+            if deadline < tick {
+                return at_once;
+            }
+            let counted = self.axis.timeline.program_from(deadline, &f).segments.len();
+            if counted <= carried.min(f.max_segments) {
+                let latest = deadline + self.seen_ticks() + 2 * lead;
+                return if self.coverable(&self.axis.timeline, latest, f.max_segments) {
+                    deadline
+                } else {
+                    at_once
+                };
+            }
+            carried = counted;
+        }
+        at_once
     }
 
-    /// Whether the rest of the running change, uploaded a poll after `tick` with `leads` times
-    /// its lead, is armed before the board has played what it holds.
-    fn extension_fits(&self, tick: u64, leads: u64) -> bool {
+    /// Whether the rest of the running change, uploaded a poll after `tick`, is armed before
+    /// the board has played what it holds.
+    fn extension_fits(&self, tick: u64) -> bool {
+        self.extension_swap(tick + self.seen_ticks(), 1.0) < self.covered
+    }
+
+    /// The earliest tick the rest of the running change, uploaded from board tick `tick`, can
+    /// be swapped to with `margin`: the first `at` whose upload (the timeline's program from
+    /// `at`) takes no more than `at − tick` as [`Runner::lead`] has it. A later swap carries
+    /// fewer segments, so the condition, once met, holds on: found by bisection.
+    fn extension_swap(&self, tick: u64, margin: f64) -> u64 {
         let f = self.axis.settings.format;
-        let left = self.axis.timeline.program_from(tick, &f).segments.len();
-        tick + self.seen_ticks() + leads * self.lead(left, 1.0) < self.covered
+        let fits = |at: u64| {
+            let n = self.axis.timeline.segments_from(at, &f).len();
+            at >= tick + self.lead(n.min(f.max_segments), margin)
+        };
+        let mut hi = tick
+            + self.lead(
+                self.axis
+                    .timeline
+                    .segments_from(tick, &f)
+                    .len()
+                    .min(f.max_segments),
+                margin,
+            );
+        let mut lo = tick;
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if fits(mid) {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        hi
     }
 
     /// When the timeline goes on past the program the board holds (a change longer than
     /// the program memory), uploads the rest and swaps to it before the board's ends: at
-    /// once when `now`, else when it can wait no longer ([`Runner::can_defer_extension`]),
-    /// the standby bank free meanwhile (a change that comes makes this upload moot).
+    /// once when `now`, else when it can wait no longer ([`Runner::defer_deadline`]), the
+    /// standby bank free meanwhile (a change that comes makes this upload moot).
     fn extend(&mut self, now: bool) -> Result<(), RunError> {
         let f = self.axis.settings.format;
         let mut margin = 1.0;
@@ -521,11 +641,16 @@ impl<L: Link> Runner<'_, L> {
                 return Ok(());
             }
             let tick = self.board_now();
-            if !now && margin == 1.0 && self.can_defer_extension(tick) {
-                return Ok(());
+            if !now && margin == 1.0 {
+                let until = match self.defer_until {
+                    Some(u) => u,
+                    None => *self.defer_until.insert(self.defer_deadline(tick)),
+                };
+                if tick <= until {
+                    return Ok(());
+                }
             }
-            let left = self.axis.timeline.program_from(tick, &f).segments.len();
-            let at = tick + self.lead(left, margin);
+            let at = self.extension_swap(tick, margin);
             if at >= self.covered {
                 return Err(too_slow());
             }
@@ -551,10 +676,7 @@ impl<L: Link> Runner<'_, L> {
     /// poll period, and two READ_STATE round trips (the one under way when the swap passes
     /// reads the tick before it).
     fn seen_ticks(&self) -> u64 {
-        let f = &self.axis.settings.format;
-        let read = frame_bytes(&Command::ReadState, f)
-            + Reply::State(self.last).to_frame(0).to_bytes().len();
-        let round_trip = read as f64 * self.link.byte_ticks() + self.overhead;
+        let round_trip = self.bytes.read as f64 * self.link.byte_ticks() + self.overhead;
         self.poll_ticks + (2.0 * round_trip).ceil() as u64
     }
 
@@ -567,16 +689,7 @@ impl<L: Link> Runner<'_, L> {
 
     /// Host ticks the frames of an upload of `n` segments take on the wire.
     fn upload_wire(&self, n: usize) -> f64 {
-        let f = &self.axis.settings.format;
-        let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
-        let load = Command::LoadSegment {
-            index: 0,
-            segment: crate::program::Segment { ticks: 1, snap: 0 },
-        };
-        let commit = frame_bytes(&Command::Commit { count: 0 }, f);
-        let swap = frame_bytes(&Command::SwapAt { tick: 0 }, f);
-        let bytes = n * (frame_bytes(&load, f) + ack) + commit + swap + 2 * ack;
-        bytes as f64 * self.link.byte_ticks()
+        (n * self.bytes.load + self.bytes.arm) as f64 * self.link.byte_ticks()
     }
 
     /// The lead a swap of an upload of `n` segments is armed with: its time
@@ -622,11 +735,13 @@ pub fn run<L: Link>(
         poll_ticks: ticks_of(opts.poll_ms, ts).max(1),
         polled: 0.0,
         reply_wire: 0.0,
+        planning: 0,
+        defer_until: None,
+        bytes: FrameBytes::of(&settings.format, first),
     };
     let start = first.ticks;
     let f = settings.format;
     let home = f.position_physical(first.x);
-    let poll = ticks_of(opts.poll_ms, ts).max(1);
     let mut swaps = Vec::new();
     let mut event_commands = Vec::new();
     let mut refused_overrides = Vec::new();
@@ -638,8 +753,8 @@ pub fn run<L: Link>(
     // A position trigger never reached ends the run at the settle time after the last event.
     let end_by = last_due + ticks_of(opts.settle_ms, ts);
     loop {
-        let now = r.poll()?.ticks;
-        r.extend(false)?;
+        r.poll()?;
+        let now = r.last.ticks;
         let here = f.position_physical(r.last.x);
         let is_due = |e: &Event| {
             let reached = e.at_position.is_none_or(|p| {
@@ -648,6 +763,11 @@ pub fn run<L: Link>(
             });
             start + ticks_of(e.at_ms, ts) <= now && reached
         };
+        // The rest of a long change goes up when it can wait no longer, unless a change is due
+        // (which replaces it, or uploads it first when it must: `Runner::change`).
+        if !script.get(next).is_some_and(is_due) {
+            r.extend(false)?;
+        }
         if let Some(e) = script.get(next) {
             if is_due(e) {
                 // Every event due by now, planned together. Events are taken in order: one is
@@ -661,7 +781,6 @@ pub fn run<L: Link>(
                         (start + ticks_of(e.at_ms, ts)).max(before)
                     }
                 };
-                let due = released(e, event_ticks.last().copied().unwrap_or(start));
                 let first = next;
                 let mut reqs = Vec::new();
                 while let Some(e) = script.get(next) {
@@ -690,6 +809,7 @@ pub fn run<L: Link>(
                 }
                 let only: Vec<Request> = reqs.iter().map(|(_, q)| *q).collect();
                 let events: Vec<usize> = reqs.iter().map(|(e, _)| *e).collect();
+                let due = event_ticks[events[0]];
                 let (swap, refused) = r.change(&events, due, &only)?;
                 swaps.extend(swap);
                 // A refused command is in Error; a refused override changes nothing.
@@ -714,13 +834,13 @@ pub fn run<L: Link>(
                 break;
             }
             let wait = (start + ticks_of(e.at_ms, ts)).saturating_sub(now);
-            r.link.wait(poll.min(wait).max(1));
+            r.link.wait(r.poll_ticks.min(wait).max(1));
             continue;
         }
         if r.settled(now) || now >= end_by {
             break;
         }
-        r.link.wait(poll);
+        r.link.wait(r.poll_ticks);
     }
     r.poll()?;
     Ok(RunReport {

@@ -318,7 +318,7 @@ impl Timeline {
     /// What the fabric plays from tick `t` on, whole: [`Timeline::program_from`] before it
     /// is cut to the program memory (a long change goes up in several uploads).
     pub fn segments_from(&self, t: u64, format: &Format) -> Vec<Segment> {
-        let mut segments = Vec::new();
+        let mut segments = Vec::with_capacity(format.max_segments);
         let mut tick = self.origin.0;
         for p in &self.parts {
             if p.start_tick > tick && p.start_tick > t {
@@ -326,6 +326,10 @@ impl Timeline {
                 hold(&mut segments, p.start_tick - tick.max(t));
             }
             tick = p.end_tick();
+            if tick <= t {
+                // Played out before `t`.
+                continue;
+            }
             let mut skip = t.saturating_sub(p.start_tick);
             for s in &p.program.segments {
                 let n = u64::from(s.ticks);
