@@ -408,8 +408,9 @@ fn a_state_beyond_lowered_limits_comes_back_without_reversal() {
 /// The bound met against Ruckig (docs/MODEL.md §11): on the seeded set, the median, 90th and
 /// 99th percentile of the ticks over Ruckig's duration (measured 7.4, 10.8, 14.7); on every
 /// plan, no more than `RUCKIG_ABOVE_TICKS` ticks or `RUCKIG_ABOVE_SHARE` of Ruckig's duration
-/// over it, whichever is more (measured: at most 49 ticks on the seeded set; 126 ticks, 0.23 %,
-/// over 20 000 states), or `NEAR_STOP_SHARE` of it for a target within `NEAR_STOP_TICKS` ticks
+/// over it, whichever is more (measured: at most 49 ticks on the seeded set; over 20 000
+/// random states at most 0.33 %: moves that brake through zero and come back, whose continuous
+/// profile is itself up to 0.26 % longer than Ruckig's), or `NEAR_STOP_SHARE` of it for a target within `NEAR_STOP_TICKS` ticks
 /// of travel of where braking at once stops the axis: there the integer chain, whose brake
 /// cannot be shortened by a fraction of a tick, may have to reverse by a hair (or brake and
 /// move on) where the continuous profile just stops.
@@ -417,7 +418,7 @@ const MEDIAN_ABOVE_RUCKIG: f64 = 9.0;
 const P90_ABOVE_RUCKIG: f64 = 13.0;
 const P99_ABOVE_RUCKIG: f64 = 20.0;
 const RUCKIG_ABOVE_TICKS: f64 = 64.0;
-const RUCKIG_ABOVE_SHARE: f64 = 0.003;
+const RUCKIG_ABOVE_SHARE: f64 = 0.004;
 const NEAR_STOP_TICKS: f64 = 8.0;
 const NEAR_STOP_SHARE: f64 = 0.02;
 
@@ -556,9 +557,9 @@ fn durations_against_ruckig_and_refusals() {
 /// same target again at rest and a blend at half the velocity limit. Every plan made is
 /// stepped here: exact end, within the limits on every tick. None is refused at rest (a blend
 /// point already passed, BlendUnreachable, is a right answer; a blend may be refused, counted);
-/// the plans that brake to rest first are counted (measured: 7 of 720, all from states in the
+/// the plans that brake to rest first are counted (measured: 9 of 720, from states in the
 /// final brake of a jerk-limited move whose rounding asks one tick more than the brake
-/// playing), bound 2 %.
+/// playing, 2 of them since a program that dips back past the target is refused), bound 2 %.
 #[test]
 fn replans_from_states_on_a_trajectory_are_exact_and_rarely_refused() {
     let f = Format::default();

@@ -285,6 +285,9 @@ pub struct Caps {
     pub a: [i128; 3],
     /// Jerk (order 3; `i128::MAX` for order 2).
     pub j: i128,
+    /// `±1`: the velocity never points against this direction (a position target ahead of a
+    /// start that is not moving away from it: the axis does not reverse); 0: no such cap.
+    pub heading: i128,
 }
 
 impl Caps {
@@ -988,9 +991,11 @@ fn check_ticks(
     let v = (p.v.min(q.v), p.v.max(q.v));
     let a = (p.a.min(q.a), p.a.max(q.a));
     let mag = |r: (i128, i128)| r.0.saturating_abs().max(r.1.saturating_abs());
+    let against = (caps.heading > 0 && v.0 < 0) || (caps.heading < 0 && v.1 > 0);
     let over = p.j.abs().max(q.j.abs()) > caps.j
         || mag(a) > caps.a_cap(v, a, q.v.saturating_add(q.a), cap)
-        || mag(v) > caps.v;
+        || mag(v) > caps.v
+        || against;
     if over {
         Err(ExactFailure::Limit)
     } else {

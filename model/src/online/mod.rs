@@ -305,6 +305,7 @@ fn setup<'a>(
             lim.acc.max(lim.dec).max(a_entry),
         ],
         j: lim.j.max(start.j.saturating_abs()),
+        heading: 0,
     };
     // A start whose acceleration is beyond the limit of its direction keeps it while its first
     // transition brings it back.
@@ -353,6 +354,15 @@ fn setup<'a>(
             let dist =
                 exact::to_f64(end.checked_sub(start.x).ok_or(OnlineError::Overflow)?) - cont.dx;
             let dir = position::direction(o, cont.v, cont.a, dist, v_end as f64, &lim.tick);
+            // A start not moving away from the target, nor bound to (its first two ticks are
+            // decided, and releasing its acceleration at full jerk reaches `vi_ticks`), is taken
+            // there without reversing: an exact program that would dip back is not taken (the
+            // next attempt, or stop and go, is).
+            let heading = dir as i128;
+            if [start.v, v1, v2].iter().all(|v| v.signum() * heading >= 0) && vi_ticks * dir >= 0.0
+            {
+                caps.heading = heading;
+            }
             Some((centre, dist, dir))
         }
     };

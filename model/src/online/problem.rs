@@ -333,13 +333,26 @@ pub(super) fn build(
     if pieces.iter().any(|d| d.ticks >= 1 << 40) {
         return Err(OnlineError::Overflow);
     }
+    // The side the end velocity is approached from: the last transition's, except at rest
+    // after a position move, which is approached from its direction whatever the last
+    // transition (a pulse from rest to rest, `Branch::Ease`, rises and falls back).
+    let approach = match setup.goal {
+        Some((_, _, dir)) if setup.v_end == 0 => -(dir as i128),
+        _ => {
+            if rise {
+                1
+            } else {
+                -1
+            }
+        }
+    };
     let problem = Problem {
         order: o,
         pieces,
         free,
         conditions,
         v_end: setup.v_end,
-        approach: if rise { 1 } else { -1 },
+        approach,
         x_centre,
         guess,
         cruise,
