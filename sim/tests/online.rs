@@ -126,6 +126,8 @@ fn lands_on(r: &RunReport, mm: f64) {
     let last = r.last;
     assert_eq!((last.x, last.v, last.a, last.j), (end.x, 0, 0, 0));
     assert_eq!(DEFAULT_FORMAT.output_lsb(last.x), cell(mm));
+    // Several reads compared (one a poll period, 2 ms; a change is planned from the poll that
+    // found it due, without reading again).
     assert!(
         r.checks >= 5,
         "the driver compared the board's state {} times",
@@ -272,9 +274,12 @@ fn an_override_cut_slows_without_reversal_and_still_lands() {
 
 #[test]
 fn an_override_of_zero_pauses_on_the_path_and_resumes() {
+    // 60 mm: on the co-simulation link (125 000 baud) the override may take effect 100+ ms
+    // late, behind the move's own uploads, and must still find room to stop on the path (a
+    // stop that would pass the target ends on it instead: the compose.rs unit tests).
     let r = play(
         &[
-            at(0.0, mv(20.0, 200.0, BufferMode::Aborting)),
+            at(0.0, mv(60.0, 200.0, BufferMode::Aborting)),
             Event {
                 at_position: None,
                 at_ms: 30.0,
@@ -282,7 +287,7 @@ fn an_override_of_zero_pauses_on_the_path_and_resumes() {
             },
             Event {
                 at_position: None,
-                at_ms: 150.0,
+                at_ms: 500.0,
                 action: Action::Override { r#override: 1.0 },
             },
         ],
@@ -292,10 +297,10 @@ fn an_override_of_zero_pauses_on_the_path_and_resumes() {
     // It came to rest short of the target, then went on.
     let paused = r.axis.timeline.parts.iter().find(|p| p.paused).unwrap();
     assert_eq!((paused.end.v, paused.end.a, paused.end.j), (0, 0, 0));
-    assert!(DEFAULT_FORMAT.output_lsb(paused.end.x) < cell(20.0));
+    assert!(DEFAULT_FORMAT.output_lsb(paused.end.x) < cell(60.0));
     let (_, reversed, _) = replay(&r);
     assert!(!reversed);
-    lands_on(&r, 20.0);
+    lands_on(&r, 60.0);
 }
 
 #[test]

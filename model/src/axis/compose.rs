@@ -3,7 +3,7 @@
 
 use crate::chain::ChainState;
 use crate::format::{Format, Quantity};
-use crate::online::{plan_online, OnlineError, OnlineLimits, OnlineTarget};
+use crate::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
 use crate::program::{Program, Segment};
 
 use super::{
@@ -98,12 +98,29 @@ impl HostAxis {
     /// speed is not below the speed it slows from, and the replanned move would not end sooner
     /// (the path left is too short to go faster; a replan from such a state may have to stop
     /// and go again): then that move plays on as planned and only the ones after it are
-    /// replanned.
+    /// replanned. So it does at override 0 when a stop on the path would come to rest on or
+    /// past the move's target ([`STOPPED_ON_TARGET`]): the brake it is in stops it there.
     fn plan_override(&self, at: u64, k: f64) -> Result<Change, Refusal> {
         let replanned = self.plan_change_with(at, Request::Override(k), false, false);
         let Some(p) = self.timeline.parts.iter().find(|p| p.end_tick() > at) else {
             return replanned;
         };
+        if k == 0.0 {
+            let past = replanned.as_ref().is_ok_and(|c| {
+                c.notes
+                    .iter()
+                    .any(|(c, n)| *c == p.command && n == STOPPED_ON_TARGET)
+            });
+            return if past && self.slows_to_its_end(p, at) {
+                let kept = self.plan_change_with(at, Request::Override(k), false, true);
+                kept.map(|mut c| {
+                    c.notes.push((p.command, STOPPED_ON_TARGET.into()));
+                    c
+                })
+            } else {
+                replanned
+            };
+        }
         let keeps = k > 0.0
             && self.slows_to_its_end(p, at)
             && matches!(self.commands[p.command].command,
@@ -124,9 +141,10 @@ impl HostAxis {
         }
     }
 
-    /// True when part `p` (a move to a position) only slows down from tick `at` to its end:
-    /// moving at `at`, its acceleration never along the motion and its velocity never crossing
-    /// zero before its end. The acceleration is linear between segment ends (orders 2 and 3),
+    /// True when part `p` (a move to a position) only slows down (or holds its speed) from tick
+    /// `at` to its end: moving at `at`, its acceleration never along the motion and its
+    /// velocity never crossing zero before its end. (A cruise before the brake passes: the
+    /// caller keeps the part only when a replan would not end sooner.) The acceleration is linear between segment ends (orders 2 and 3),
     /// so the segment ends decide.
     fn slows_to_its_end(&self, p: &Part, at: u64) -> bool {
         let f = &self.settings.format;
@@ -199,7 +217,7 @@ impl HostAxis {
                 k = f;
                 keep = playing_from;
                 if keep_playing {
-                    keep = playing_from + 1;
+                    keep = (playing_from + 1).min(self.timeline.parts.len());
                 }
             }
             Request::Command(new) => {
@@ -451,6 +469,11 @@ fn check_inputs(c: &MotionCommand, f: &Format) -> Result<(), AxisErrorId> {
 
 type Planned = (Program, ChainState, Goal, bool, Option<String>);
 
+/// The note of a move whose stop on the path (override 0) would have come to rest on or past
+/// its target: it stops on the target instead.
+pub const STOPPED_ON_TARGET: &str =
+    "override 0 too near the target to stop before it: stopped on it";
+
 /// Plans one command's part from `from` with override `k`: a position move to its target at
 /// rest or at the blend velocity with `next`, a velocity, a halt.
 fn plan_part(
@@ -519,12 +542,34 @@ fn plan_part(
                 deceleration,
                 jerk,
             };
-            if k == 0.0 {
-                let (p, e) = stop(l)?;
-                return Ok((p, e, Goal::Velocity(0.0), true, None));
-            }
             let cell = cell_of(position, f);
             let here = f.output_lsb(from.x);
+            if k == 0.0 {
+                // A stop on the path, unless it would come to rest on or past the target
+                // (the axis would then have to come back): the move ends on its target
+                // instead, braking as it would have.
+                let (p, e) = stop(l)?;
+                let dir = if from.v != 0 {
+                    from.v.signum()
+                } else {
+                    (cell - here).signum()
+                };
+                if (f.output_lsb(e.x) - cell) * dir < 0 {
+                    return Ok((p, e, Goal::Velocity(0.0), true, None));
+                }
+                let (p, e) = run(
+                    OnlineTarget::Position {
+                        cell,
+                        velocity: 0.0,
+                    },
+                    l,
+                )?;
+                let goal = Goal::Position {
+                    cell,
+                    velocity: 0.0,
+                };
+                return Ok((p, e, goal, false, Some(STOPPED_ON_TARGET.into())));
+            }
             let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
             let l = scaled(l, k);
             let vb = vb * k;
@@ -558,10 +603,20 @@ fn plan_part(
                 Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
                 Err(OnlineError::BlendUnreachable) if vb != 0.0 => {
                     // Too fast to slow to the blend velocity by the blend point (an override
-                    // cut on a short move): the lowest blend velocity up to the speed now that
-                    // can be reached, found to 1/64 of the way; else as buffered.
-                    let now = f.to_physical(Quantity::Velocity, from.v.abs());
-                    let mut hi = now.max(vb.abs());
+                    // cut on a short move): the lowest blend velocity that can be reached, up
+                    // to the speed the axis reaches releasing its acceleration at full jerk
+                    // (seed 002 eq 32), found to 1/64 of the way; else as buffered.
+                    let to = |q, r: i128| f.to_physical(q, r);
+                    let (v, a) = (
+                        to(Quantity::Velocity, from.v),
+                        to(Quantity::Acceleration, from.a),
+                    );
+                    let release = match axis.settings.order {
+                        OnlineOrder::Three => a * a.abs() / (2.0 * jerk),
+                        OnlineOrder::Two => 0.0,
+                    };
+                    let reached = (v + release).abs().max(v.abs());
+                    let mut hi = reached.max(vb.abs() * (1.0 + 1.0 / 64.0));
                     let mut found = blend(hi * vb.signum()).ok().map(|r| (hi, r));
                     if found.is_some() {
                         let mut lo = vb.abs();
@@ -673,7 +728,6 @@ impl HostAxis {
 mod tests {
     use super::*;
     use crate::axis::AxisSettings;
-    use crate::online::OnlineOrder;
     use crate::DEFAULT_FORMAT;
 
     fn mv(position: f64, velocity: f64) -> MotionCommand {
@@ -825,6 +879,39 @@ mod tests {
                 new.len(),
                 v.len()
             );
+        }
+    }
+
+    /// Override 0 a few ticks into the final brake (the brake at full deceleration cannot stop
+    /// before the target): the move stops on its target, never past it and back, and is done
+    /// there; earlier, at cruise, it stops on the path (paused) short of the target.
+    #[test]
+    fn an_override_of_zero_in_the_final_brake_stops_on_the_target() {
+        let f = DEFAULT_FORMAT;
+        for order in [OnlineOrder::Three, OnlineOrder::Two] {
+            let axis = moving(order, 20.0, 200.0);
+            let v = velocities(&axis.timeline, 0);
+            let top = v.iter().map(|v| v.abs()).max().unwrap();
+            let brake = v.iter().rposition(|v| v.abs() == top).unwrap() as u64;
+            for at in [brake + 5, brake + 50] {
+                let (c, refused) = axis.plan_batch(at, &[Request::Override(0.0)]);
+                assert!(refused.is_empty());
+                let c = c.unwrap();
+                let last = c.timeline.parts.last().unwrap();
+                assert!(!last.paused, "{order:?} at {at}: paused past the target");
+                assert!(last.end.is_at_rest());
+                assert_eq!(f.output_lsb(last.end.x), 20_000_000, "{order:?} at {at}");
+                let w = velocities(&c.timeline, at);
+                assert!(w.iter().all(|v| *v >= 0), "{order:?} at {at}: reversed");
+                assert!(c.notes.iter().any(|(_, n)| n.contains("stopped on it")));
+            }
+            let (c, _) = axis.plan_batch(brake / 2, &[Request::Override(0.0)]);
+            let last = c.unwrap().timeline.parts.last().unwrap().clone();
+            assert!(
+                last.paused && last.end.is_at_rest(),
+                "{order:?}: not paused"
+            );
+            assert!(f.output_lsb(last.end.x) < 20_000_000);
         }
     }
 }
