@@ -763,10 +763,16 @@ mod tests {
     /// speed to its end), and the speed there (raw).
     fn in_final_brake(axis: &HostAxis) -> (u64, i128) {
         let v = velocities(&axis.timeline, 0);
-        let top = v.iter().map(|v| v.abs()).max().unwrap();
-        let k = v.iter().rposition(|v| v.abs() == top).unwrap();
+        let k = brake_start(axis) as usize;
         let at = k + (v.len() - k) / 3;
         (at as u64, v[at].abs())
+    }
+
+    /// The last tick at the move's top speed (its final brake begins after it).
+    fn brake_start(axis: &HostAxis) -> u64 {
+        let v = velocities(&axis.timeline, 0);
+        let top = v.iter().map(|v| v.abs()).max().unwrap();
+        v.iter().rposition(|v| v.abs() == top).unwrap() as u64
     }
 
     #[test]
@@ -890,9 +896,7 @@ mod tests {
         let f = DEFAULT_FORMAT;
         for order in [OnlineOrder::Three, OnlineOrder::Two] {
             let axis = moving(order, 20.0, 200.0);
-            let v = velocities(&axis.timeline, 0);
-            let top = v.iter().map(|v| v.abs()).max().unwrap();
-            let brake = v.iter().rposition(|v| v.abs() == top).unwrap() as u64;
+            let brake = brake_start(&axis);
             for at in [brake + 5, brake + 50] {
                 let (c, refused) = axis.plan_batch(at, &[Request::Override(0.0)]);
                 assert!(refused.is_empty());
