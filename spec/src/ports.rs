@@ -1,0 +1,356 @@
+//! The ports of the generated blocks and the board's pins, each list written once.
+//!
+//! [`with_motion_core_ports!`] and [`with_io_top_ports!`] call a macro of the caller's with the
+//! block's ports, grouped in sections by direction and by what drives them:
+//!
+//! ```text
+//! clock: "doc";
+//! inputs  { section { name: bit[1] bool, "doc"; name: bits[WIDTH] RustType, "doc"; … } … }
+//! outputs { section { … } … }
+//! ```
+//!
+//! `bit` ports are one wire (the fabric's `Bit`, the model's `bool`); `bits[W]` ports are `W`
+//! wires holding two's complement or an unsigned count (the Rust type says which). The fabric
+//! declares its blocks' ports from these lists (`snapgen_hdl`), the model its port structs
+//! (`snapgen_model`), the co-simulation its word layouts and harness header (`snapgen_sim`);
+//! [`MOTION_CORE`] and [`IO_TOP`] are the same lists as tables, for the generators. Sections
+//! let a block take part of another's list: the executor drives the core's `command` inputs
+//! and reads its `status` outputs.
+//!
+//! The I/O top's `axis` sections are per axis: a design with several axes repeats them, and
+//! [`board_pins`] numbers them.
+
+/// A port's direction, seen from the block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Dir {
+    /// Into the block.
+    In,
+    /// Out of the block.
+    Out,
+}
+
+impl Dir {
+    /// As Verilog writes it.
+    pub fn verilog(self) -> &'static str {
+        match self {
+            Dir::In => "input",
+            Dir::Out => "output",
+        }
+    }
+}
+
+/// One port of a block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Port {
+    /// Name (the same in the fabric, the model and the harness).
+    pub name: &'static str,
+    /// Direction.
+    pub dir: Dir,
+    /// Width in bits.
+    pub bits: u32,
+    /// The section of the list it belongs to.
+    pub section: &'static str,
+    /// What it carries.
+    pub doc: &'static str,
+}
+
+/// A block's port list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Block {
+    /// The clock input's name.
+    pub clock: &'static str,
+    /// Every other port, inputs first, in declaration order.
+    pub ports: &'static [Port],
+}
+
+impl Block {
+    /// Its inputs (without the clock), in order.
+    pub fn inputs(&self) -> impl Iterator<Item = &'static Port> {
+        self.ports.iter().filter(|p| p.dir == Dir::In)
+    }
+
+    /// Its outputs, in order.
+    pub fn outputs(&self) -> impl Iterator<Item = &'static Port> {
+        self.ports.iter().filter(|p| p.dir == Dir::Out)
+    }
+
+    /// The port called `name`.
+    pub fn port(&self, name: &str) -> Option<&'static Port> {
+        self.ports.iter().find(|p| p.name == name)
+    }
+
+    /// The ports of `section`.
+    pub fn section(&self, section: &'static str) -> impl Iterator<Item = &'static Port> {
+        self.ports.iter().filter(move |p| p.section == section)
+    }
+}
+
+/// Calls `$callback! { $($extra)* <the motion core's ports> }` (see the module documentation).
+#[macro_export]
+macro_rules! with_motion_core_ports {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            clock: "Fabric clock.";
+            inputs {
+                reset {
+                    reset: bit[1] bool, "Synchronous reset, active high.";
+                }
+                config {
+                    tick_div: bits[$crate::widths::TICK_BITS] u32, "Clocks per tick minus one (0: a tick every clock).";
+                    stop_jerk: bits[$crate::widths::D_BITS] i128, "The controlled stop's jerk limit, raw (> 0; latched when a stop is taken).";
+                    stop_accel: bits[$crate::widths::D_BITS] i128, "The controlled stop's acceleration limit, raw (≥ `stop_jerk`; latched likewise).";
+                }
+                encoder {
+                    load_position: bits[$crate::widths::POSITION_BITS] u32, "The cell for `load` (the encoder count).";
+                }
+                command {
+                    start: bit[1] bool, "Start the standby program (one-clock pulse; ignored while busy or stopping).";
+                    abort_move: bit[1] bool, "Emergency stop: sequencer idle, v = a = j = 0 now, position holds, stop cancelled.";
+                    stop: bit[1] bool, "Controlled stop: taken on the next tick, ends at rest within the stop limits.";
+                    load: bit[1] bool, "The reference takes the encoder's position: x at the centre of cell `load_position`, v = a = j = 0 (raised only at rest, with no program playing).";
+                    write_enable: bit[1] bool, "Write one segment of the standby program.";
+                    write_address: bits[$crate::widths::ADDR_BITS] u8, "Segment address to write.";
+                    write_ticks: bits[$crate::widths::TICK_BITS] u32, "Segment tick count to write (≥ 1).";
+                    write_snap: bits[$crate::widths::D_BITS] i128, "Segment snap to write (two's complement).";
+                    count_enable: bit[1] bool, "Set the standby program's segment count.";
+                    count_value: bits[$crate::widths::INDEX_BITS] u8, "Segment count to set.";
+                    swap: bit[1] bool, "Arm a program swap (one-clock pulse).";
+                    swap_last: bits[$crate::widths::SWAP_BITS] u32, "The low bits of the time base on the old program's last tick: the registers at `swap_last + 1` are the new program's start.";
+                }
+            }
+            outputs {
+                registers {
+                    x: bits[$crate::widths::X_BITS] i128, "Position register, raw.";
+                    v: bits[$crate::widths::V_BITS] i128, "Velocity register, raw.";
+                    a: bits[$crate::widths::A_BITS] i128, "Acceleration register, raw.";
+                    j: bits[$crate::widths::J_BITS] i128, "Jerk register, raw.";
+                    position: bits[$crate::widths::POSITION_BITS] u32, "Position in whole output LSBs (`x >> FRAC_BITS`, low bits).";
+                }
+                status {
+                    busy: bit[1] bool, "A program is playing.";
+                    done: bit[1] bool, "The last program ran to its end.";
+                    aborted: bit[1] bool, "The last program was cut short (by a stop or an abort).";
+                    stopping: bit[1] bool, "A controlled stop is requested or running.";
+                    stop_over: bit[1] bool, "The last stop began outside its limits (and landed regardless of them).";
+                    tick_count: bits[$crate::widths::TICK_BITS] u32, "Ticks since the start, while a program plays or a stop runs.";
+                    ticks: bits[$crate::widths::TIME_BITS] u64, "Ticks since reset: the board's time base.";
+                    heading_pos: bit[1] bool, "The axis heads forward (registered): on the last clock the first non-zero of v, a, j was positive.";
+                    heading_neg: bit[1] bool, "The axis heads backward (registered).";
+                    at_rest: bit[1] bool, "The chain is at rest: v = a = j = 0.";
+                    tick: bit[1] bool, "The tick enable (one clock wide).";
+                    standby_count: bits[$crate::widths::INDEX_BITS] u8, "Segment count of the standby program (0: nothing to start).";
+                    swap_pending: bit[1] bool, "A program swap is armed.";
+                }
+                debug {
+                    segment: bits[$crate::widths::INDEX_BITS] u8, "Segment playing.";
+                    active_bank: bit[1] bool, "Bank that plays (the other one is written).";
+                }
+            }
+        }
+    };
+}
+
+/// Calls `$callback! { $($extra)* <the I/O top's ports> }` (see the module documentation).
+/// The `axis` sections are one axis's pins.
+#[macro_export]
+macro_rules! with_io_top_ports {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            clock: "Fabric clock.";
+            inputs {
+                reset {
+                    reset: bit[1] bool, "Synchronous reset, active high.";
+                }
+                machine {
+                    uart_rx: bit[1] bool, "UART receive line (idles high).";
+                    estop: bit[1] bool, "Emergency stop (polarity set by INPUT_POLARITY).";
+                }
+                axis {
+                    enc_a: bit[1] bool, "Encoder channel A.";
+                    enc_b: bit[1] bool, "Encoder channel B.";
+                    enc_i: bit[1] bool, "Encoder index.";
+                    limit_pos: bit[1] bool, "Positive limit switch (polarity set by INPUT_POLARITY).";
+                    limit_neg: bit[1] bool, "Negative limit switch.";
+                }
+            }
+            outputs {
+                machine {
+                    uart_tx: bit[1] bool, "UART transmit line.";
+                    led_idle: bit[1] bool, "LED 0: idle.";
+                    led_busy: bit[1] bool, "LED 1: busy (a program plays or a stop runs).";
+                    led_fault: bit[1] bool, "LED 2: fault (ErrorStop, a UART framing error or an encoder error seen).";
+                    led_heartbeat: bit[1] bool, "LED 3: heartbeat.";
+                }
+                axis {
+                    pwm: bit[1] bool, "PWM output.";
+                    dir: bit[1] bool, "Direction output.";
+                    amplifier: bit[1] bool, "Amplifier enable (low: the amplifier must not drive the motor).";
+                }
+                debug {
+                    status: bits[$crate::fields::STATUS_BITS as u32] u8, "The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits 7:0: for co-simulation and debugging.";
+                }
+            }
+        }
+    };
+}
+
+/// Builds a [`Block`] table from a port list.
+macro_rules! block_table {
+    (
+        $table:ident, $what:literal;
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        #[doc = concat!("The ports of ", $what, ".")]
+        pub const $table: Block = Block {
+            clock: "clock",
+            ports: &[
+                $( $( Port { name: stringify!($i), dir: Dir::In, bits: $ib, section: stringify!($isec), doc: $idoc }, )* )*
+                $( $( Port { name: stringify!($o), dir: Dir::Out, bits: $ob, section: stringify!($osec), doc: $odoc }, )* )*
+            ],
+        };
+    };
+}
+
+with_motion_core_ports!(block_table! { MOTION_CORE, "the motion core (`snapgen_core`)"; });
+with_io_top_ports!(block_table! { IO_TOP, "the I/O top (`snapgen_io`)"; });
+
+/// What a board pin is wired to in the board top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PinUse {
+    /// The fabric clock.
+    Clock,
+    /// The reset button (active high), synchronised in the board top.
+    ResetButton,
+    /// This port of the I/O top.
+    Io(&'static str),
+}
+
+/// One pin of the board top, as a board file names it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BoardPin {
+    /// The board top's port (`led[0]`, `enc_a`, `enc_a[1]` …).
+    pub port: String,
+    /// Direction.
+    pub dir: Dir,
+    /// What it is wired to (for a per-axis pin of axis `k`, the I/O top's port of that axis).
+    pub wired: PinUse,
+    /// Axis, for a per-axis pin of a design with several axes.
+    pub axis: Option<usize>,
+    /// What it is for.
+    pub doc: &'static str,
+}
+
+/// The board top's ports that are not the I/O top's own name: (I/O top port, board port).
+/// LEDs are one vector `led`, in this order.
+pub const BOARD_NAMES: [(&str, &str); 7] = [
+    ("uart_rx", "uart_rxd"),
+    ("uart_tx", "uart_txd"),
+    ("amplifier", "amp_enable"),
+    ("led_idle", "led[0]"),
+    ("led_busy", "led[1]"),
+    ("led_fault", "led[2]"),
+    ("led_heartbeat", "led[3]"),
+];
+
+/// The clock input of every board top.
+pub const BOARD_CLOCK: &str = "sysclk";
+/// The reset button of every board top.
+pub const BOARD_RESET: &str = "btn_reset";
+
+/// The board top's pins for a design with `axes` axes: the clock, the reset button, then every
+/// I/O top port except the reset and the debug outputs (per-axis ones once per axis, numbered
+/// `name[k]` when there are several).
+pub fn board_pins(axes: usize) -> Vec<BoardPin> {
+    let mut v = vec![
+        BoardPin {
+            port: BOARD_CLOCK.into(),
+            dir: Dir::In,
+            wired: PinUse::Clock,
+            axis: None,
+            doc: "the clock (the [clock] table, not a [[pins]] entry)",
+        },
+        BoardPin {
+            port: BOARD_RESET.into(),
+            dir: Dir::In,
+            wired: PinUse::ResetButton,
+            axis: None,
+            doc: "reset button, active high",
+        },
+    ];
+    let name = |p: &Port| {
+        BOARD_NAMES
+            .iter()
+            .find(|(io, _)| *io == p.name)
+            .map_or(p.name, |(_, b)| b)
+    };
+    for p in IO_TOP
+        .ports
+        .iter()
+        .filter(|p| !matches!(p.section, "reset" | "debug"))
+    {
+        if p.section == "axis" {
+            for k in 0..axes {
+                v.push(BoardPin {
+                    port: if axes == 1 {
+                        name(p).to_string()
+                    } else {
+                        format!("{}[{k}]", name(p))
+                    },
+                    dir: p.dir,
+                    wired: PinUse::Io(p.name),
+                    axis: (axes > 1).then_some(k),
+                    doc: p.doc,
+                });
+            }
+        } else {
+            v.push(BoardPin {
+                port: name(p).to_string(),
+                dir: p.dir,
+                wired: PinUse::Io(p.name),
+                axis: None,
+                doc: p.doc,
+            });
+        }
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_sections_known() {
+        for b in [MOTION_CORE, IO_TOP] {
+            let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
+            names.push(b.clock);
+            let n = names.len();
+            names.sort_unstable();
+            names.dedup();
+            assert_eq!(names.len(), n);
+            assert!(b.ports.iter().all(|p| p.bits >= 1));
+        }
+        assert_eq!(MOTION_CORE.port("x").map(|p| p.bits), Some(112));
+        assert_eq!(MOTION_CORE.section("command").count(), 12);
+        assert_eq!(IO_TOP.port("status").map(|p| p.bits), Some(240));
+    }
+
+    #[test]
+    fn board_pins_by_axis() {
+        let one = board_pins(1);
+        let names: Vec<&str> = one.iter().map(|p| p.port.as_str()).collect();
+        assert!(
+            names.contains(&"enc_a") && names.contains(&"led[3]") && names.contains(&"amp_enable")
+        );
+        assert!(!names.contains(&"status") && !names.contains(&"reset"));
+        assert_eq!(one.len(), 17);
+        let three = board_pins(3);
+        assert!(three
+            .iter()
+            .any(|p| p.port == "pwm[2]" && p.axis == Some(2)));
+        // 8 per-axis pins: 2 more axes add 16.
+        assert_eq!(three.len(), 17 + 16);
+    }
+}

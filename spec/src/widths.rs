@@ -1,0 +1,67 @@
+//! Register widths of the generated fabric and the byte sizes they give on the wire.
+//!
+//! The chain's registers share one LSB per power of the tick (docs/MODEL.md): position
+//! [`X_BITS`] bits with [`FRAC_BITS`] fractional bits below the output LSB, velocity,
+//! acceleration, jerk and snap [`V_BITS`]. The model's default format, the fabric's widths,
+//! the protocol's field sizes and the harness's word layout are all these numbers.
+
+/// Position register width (signed, two's complement).
+pub const X_BITS: u32 = 112;
+/// Velocity register width.
+pub const V_BITS: u32 = 104;
+/// Acceleration register width.
+pub const A_BITS: u32 = 104;
+/// Jerk register width.
+pub const J_BITS: u32 = 104;
+/// Snap (a segment's value) width.
+pub const D_BITS: u32 = 104;
+/// Fractional bits of the position register below the output LSB.
+pub const FRAC_BITS: u32 = 80;
+/// Width of a segment's tick count and of the fabric's tick counter.
+pub const TICK_BITS: u32 = 32;
+/// Segment address within a program bank.
+pub const ADDR_BITS: u32 = 5;
+/// Segments per program (the depth of a program bank).
+pub const MAX_SEGMENTS: u32 = 1 << ADDR_BITS;
+/// Width of a segment index or count (holds 0..=[`MAX_SEGMENTS`]).
+pub const INDEX_BITS: u32 = ADDR_BITS + 1;
+/// Width of the whole-LSB position output (`x >> FRAC_BITS`, low bits).
+pub const POSITION_BITS: u32 = 32;
+/// Width of the time base (ticks since reset).
+pub const TIME_BITS: u32 = 64;
+/// Bits of the time base the core compares for a program swap (SWAP_AT).
+pub const SWAP_BITS: u32 = 32;
+/// Width of the encoder count.
+pub const ENCODER_BITS: u32 = 32;
+/// Width of an axis state or error identifier in the fabric.
+pub const STATE_BITS: u32 = 3;
+/// Width of a controller gain register (signed; its largest value is `2^(GAIN_BITS-1) − 1`).
+pub const GAIN_BITS: u32 = 48;
+/// Fractional bits of the controller's following error (counts · 2^-E_FRAC).
+pub const E_FRAC: u32 = 16;
+
+/// Bytes that hold `bits` bits.
+pub const fn bytes_for(bits: u32) -> usize {
+    bits.div_ceil(8) as usize
+}
+
+/// Bytes of a wide value on the wire: a snap, velocity, acceleration, jerk, stop limit or a
+/// CONFIGURE value (signed, two's complement).
+pub const WIDE_BYTES: usize = bytes_for(D_BITS);
+/// Bytes of the position register on the wire.
+pub const POSITION_BYTES: usize = bytes_for(X_BITS);
+
+const _: () = {
+    assert!(V_BITS == A_BITS && A_BITS == J_BITS && J_BITS == D_BITS);
+    assert!(X_BITS > V_BITS && X_BITS <= 127 && X_BITS >= FRAC_BITS + POSITION_BITS);
+    assert!(bytes_for(V_BITS) == WIDE_BYTES);
+};
+
+/// The largest value of a register of `bits` bits: two's complement when `signed`.
+pub const fn max_of(bits: u32, signed: bool) -> i128 {
+    if signed {
+        (1i128 << (bits - 1)) - 1
+    } else {
+        (1i128 << bits) - 1
+    }
+}
