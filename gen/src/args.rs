@@ -2,7 +2,8 @@
 //! [`MoveRequest`] and a [`Format`].
 
 use clap::Args;
-use snapgen_model::{Format, Method, MoveRequest, DEFAULT_FORMAT};
+use snapgen_model::{Format, DEFAULT_FORMAT};
+use snapgen_plan::{Method, MoveRequest};
 
 /// A command-line mistake that clap cannot see: a flag that the chosen method does not use,
 /// or one that it needs. Exit code 2, like clap's own usage errors.

@@ -14,7 +14,8 @@ use std::path::Path;
 use anyhow::{ensure, Context};
 use snapgen_model::format::Quantity;
 use snapgen_model::stop::StopLimits;
-use snapgen_model::{plan, plan_from, Format, Method, MoveRequest, Plan, DEFAULT_FORMAT};
+use snapgen_model::{Format, DEFAULT_FORMAT};
+use snapgen_plan::{plan, plan_from, Method, MoveRequest, Plan};
 use snapgen_sim::cosim::CosimConfig;
 use snapgen_sim::moves::MoveSpec;
 
@@ -222,7 +223,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     let r = &played.report;
     let f0 = r.axis.settings.format;
     // Case (a): every block done; case (b): the first block aborted while it moves.
-    use snapgen_model::axis::Outcome;
+    use snapgen_host::axis::Outcome;
     let outcomes: Vec<_> = r.axis.commands.iter().map(|c| c.outcome.clone()).collect();
     let want = [
         Outcome::Done,

@@ -14,9 +14,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use serde::Serialize;
+use snapgen_host::protocol::{Command, Reply};
 use snapgen_model::device::Design;
 use snapgen_model::io::servo::ServoConfig;
-use snapgen_model::protocol::{Command, Reply};
 use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
 use snapgen_model::{Format, Quantity, DEFAULT_FORMAT};
@@ -495,7 +495,7 @@ pub fn gains_json(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> serde_json:
         "volts": { "kp": g.volts.kp, "ki": g.volts.ki, "kd": g.volts.kd, "kv": g.volts.kv, "ka": g.volts.ka },
         "duty": { "kp": g.physical.kp, "ki": g.physical.ki, "kd": g.physical.kd, "kv": g.physical.kv, "ka": g.physical.ka },
         "configure": {
-            "SERVO_PERIOD": g.config.period, "KP": g.config.kp, "KI": g.config.ki, "KD": g.config.kd,
+            "SERVO_PERIOD": g.config.servo_period, "KP": g.config.kp, "KI": g.config.ki, "KD": g.config.kd,
             "KV": g.config.kv, "KA": g.config.ka, "INTEGRAL_LIMIT": g.config.integral_limit,
             "OUTPUT_LIMIT": g.config.output_limit, "FOLLOWING_LIMIT": g.config.following_limit,
             "D_FILTER": g.config.d_filter, "PWM_PERIOD": t.pwm_period,
@@ -551,7 +551,7 @@ pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
         c.output_limit,
         c.following_limit,
         c.d_filter,
-        c.period,
+        c.servo_period,
         t.pwm_period,
     )
 }

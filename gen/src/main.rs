@@ -25,7 +25,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use snapgen_model::{plan, Plan, PlanError};
+use snapgen_plan::{plan, Plan, PlanError};
 
 use args::{ArgError, PlanArgs};
 use report::PlanReport;
@@ -216,7 +216,7 @@ enum Command {
         reset: bool,
         /// The board's host watchdog, in milliseconds (written and read back): a moving axis
         /// that hears nothing from the host for this long stops by itself. 0 turns it off.
-        #[arg(long, default_value_t = snapgen_model::protocol::DEFAULT_WATCHDOG_MS)]
+        #[arg(long, default_value_t = snapgen_spec::Param::WatchdogMs.spec().reset_value(0) as u32)]
         watchdog_ms: u32,
         /// The axis drives a motor: configure the board's controller for it (gains derived
         /// from the plant, docs/PLANT.md) and report the following error and the settling.
@@ -832,9 +832,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 r.status.axis().map_or("?", |a| a.name()),
                 r.state.x,
                 r.status.tick_count,
-                if r.status
-                    .has(snapgen_model::protocol::flag::STOP_OVER_LIMITS)
-                {
+                if r.status.has(snapgen_host::protocol::flag::STOP_OVER_LIMITS) {
                     "; the stop left its limits on some tick (it began outside them; it landed exactly)"
                 } else {
                     ""

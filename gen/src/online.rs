@@ -1,6 +1,6 @@
 //! `snapgen online`: plays a timed script of PLCopen commands (MC_MoveAbsolute with its buffer
 //! modes, MC_MoveVelocity, MC_Halt, the feed override) on a board through the host axis
-//! (`snapgen_model::axis`): the device model or the Verilated I/O top (with the device model in
+//! (`snapgen_host::axis`): the device model or the Verilated I/O top (with the device model in
 //! lockstep) at the design's clock and baud rate, or a real board on a serial port.
 //!
 //! The script is TOML (docs/ONLINE.md):
@@ -29,15 +29,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, ensure, Context};
 use serde::{Deserialize, Serialize};
-use snapgen_model::axis::driver::{
+use snapgen_host::axis::driver::{
     power_up, run, stop_limits, Action, Event, Link, LinkError, RunOptions, RunReport,
 };
-use snapgen_model::axis::{AxisSettings, Goal, MotionCommand, Outcome};
+use snapgen_host::axis::{AxisSettings, Goal, MotionCommand, Outcome};
+use snapgen_host::protocol::{Command, Reply};
 use snapgen_model::device::Design;
-use snapgen_model::online::OnlineOrder;
-use snapgen_model::protocol::{Command, Reply};
 use snapgen_model::timing::Timing;
 use snapgen_model::{Format, Trace, DEFAULT_FORMAT};
+use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::BoardLink;
 

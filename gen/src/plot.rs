@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use plotters::prelude::*;
-use snapgen_model::{ChainState, Format, Plan, Program, Quantity as Physical, Trace};
+use snapgen_model::{ChainState, Format, Program, Quantity as Physical, Trace};
+use snapgen_plan::Plan;
 use snapgen_plant::fast::LoopSample;
 
 /// Number of time buckets drawn.

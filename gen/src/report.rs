@@ -6,7 +6,8 @@
 
 use ethnum::I256;
 use serde::Serialize;
-use snapgen_model::{planner::DurationValues, Plan, Quantity, Segment, FRAC_BITS};
+use snapgen_model::{Quantity, Segment, FRAC_BITS};
+use snapgen_plan::{planner::DurationValues, Plan};
 
 /// Peak magnitudes over every tick of the move: the program integrated independently of the
 /// planner (snapgen-verify: exact, closed form per segment, per-tick extremes).
@@ -164,10 +165,10 @@ impl PlanReport {
         PlanReport {
             order,
             method: match p.request.method {
-                snapgen_model::Method::Order4 { .. } => "order4",
-                snapgen_model::Method::Order3 { .. } => "order3",
-                snapgen_model::Method::Order2 { .. } => "order2",
-                snapgen_model::Method::Duration { .. } => "duration",
+                snapgen_plan::Method::Order4 { .. } => "order4",
+                snapgen_plan::Method::Order3 { .. } => "order3",
+                snapgen_plan::Method::Order2 { .. } => "order2",
+                snapgen_plan::Method::Duration { .. } => "duration",
             },
             ts: f.ts,
             ticks_total: p.ticks_total(),

@@ -14,8 +14,8 @@
 //!   numbers; ours are the standard's example scaled down (positions 6 and 10 mm, velocities
 //!   150 and 100 mm/s), case (a) followed by a return to 0 and case (b).
 
-use snapgen_model::axis::driver::{Action, Event};
-use snapgen_model::axis::{BufferMode, MotionCommand};
+use snapgen_host::axis::driver::{Action, Event};
+use snapgen_host::axis::{BufferMode, MotionCommand};
 
 use crate::online::Script;
 
@@ -129,5 +129,5 @@ impl Scenario {
 
 /// The output cell of a position in mm (the scenarios' unit) in `f`.
 pub fn cell_mm(mm: f64, f: &snapgen_model::Format) -> i128 {
-    snapgen_model::axis::compose::cell_of(mm, f)
+    snapgen_host::axis::compose::cell_of(mm, f)
 }

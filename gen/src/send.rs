@@ -28,13 +28,15 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serialport::SerialPort;
-use snapgen_model::format::Quantity;
-use snapgen_model::protocol::{
+use snapgen_host::protocol::{
     AxisState, Command, Decoded, Decoder, ErrorId, Identity, Param, Reason, Reply, StateReply,
-    Status, PROTOCOL_VERSION,
+    Status,
 };
+use snapgen_model::format::Quantity;
 use snapgen_model::stop::{StopFound, StopLimits};
-use snapgen_model::{plan_from, ChainState, Format, MoveRequest, Plan, Program, FRAC_BITS};
+use snapgen_model::{ChainState, Format, Program, FRAC_BITS};
+use snapgen_plan::{plan_from, MoveRequest, Plan};
+use snapgen_spec::wire::PROTOCOL_VERSION;
 
 /// Pause before resending: longer than a device's inter-byte timeout (20 ms), so a partial
 /// frame left by a corrupted one is dropped before the retry arrives.
@@ -179,7 +181,7 @@ fn reason_hint(r: Reason) -> &'static str {
 pub enum InputError {
     /// The plan failed.
     #[error(transparent)]
-    Plan(#[from] snapgen_model::PlanError),
+    Plan(#[from] snapgen_plan::PlanError),
     /// The board speaks another protocol.
     #[error("the board speaks protocol {device}, this snapgen speaks {PROTOCOL_VERSION}: use a matching snapgen, or rebuild the board's design with this one")]
     Protocol {
@@ -536,8 +538,8 @@ pub enum SendFailure {
     Link(#[from] SendError),
 }
 
-impl From<snapgen_model::PlanError> for SendFailure {
-    fn from(e: snapgen_model::PlanError) -> Self {
+impl From<snapgen_plan::PlanError> for SendFailure {
+    fn from(e: snapgen_plan::PlanError) -> Self {
         SendFailure::Input(InputError::Plan(e))
     }
 }
@@ -559,26 +561,25 @@ pub fn board_format(id: &Identity, position_lsb: f64) -> Result<Format, InputErr
     if id.clock_hz == 0 {
         return Err(bad("a clock of 0 Hz".into()));
     }
-    let w = id.widths.map(u32::from);
     let f = Format {
         ts: id.ts(),
         position_lsb,
         widths: snapgen_model::Widths {
-            x: w[0],
-            v: w[1],
-            a: w[2],
-            j: w[3],
-            d: w[4],
+            x: u32::from(id.x_bits),
+            v: u32::from(id.v_bits),
+            a: u32::from(id.a_bits),
+            j: u32::from(id.j_bits),
+            d: u32::from(id.d_bits),
         },
         tick_bits: u32::from(id.tick_bits),
         max_segments: usize::from(id.max_segments),
     };
     f.validate()
-        .map_err(|e| bad(format!("registers {w:?}: {e}")))?;
+        .map_err(|e| bad(format!("registers {:?}: {e}", f.widths.as_array())))?;
     if usize::from(id.snap_bytes) != Program::snap_bytes(&f) {
         return Err(bad(format!(
             "{} snap bytes for a {}-bit snap",
-            id.snap_bytes, w[4]
+            id.snap_bytes, id.d_bits
         )));
     }
     Ok(f)
@@ -884,9 +885,13 @@ fn configure_servo(
     };
     let g = snapgen_plant::gains::derive(&s.plant.physical(), &s.design, &timing)
         .map_err(|e| bad(e.to_string()))?;
-    let writes = snapgen_model::io::executor::Config::servo_writes(&g.config);
-    // SERVO_PERIOD and FOLLOWING_LIMIT are set only while Disabled.
-    let (fixed, rest) = writes.split_at(2);
+    let writes = g.config.writes();
+    // Those set only while Disabled (SERVO_PERIOD, FOLLOWING_LIMIT) come first.
+    let disabled_only = writes
+        .iter()
+        .take_while(|(p, _)| p.settable() == snapgen_spec::Settable::Disabled)
+        .count();
+    let (fixed, rest) = writes.split_at(disabled_only);
     if axis != AxisState::Disabled {
         let mut same = true;
         for &(p, v) in fixed {
@@ -1003,7 +1008,7 @@ pub fn stop(
         std::thread::sleep(Duration::from_millis(20));
         let s = link.status()?;
         let axis = s.axis().unwrap_or(AxisState::ErrorStop);
-        if !s.has(snapgen_model::protocol::flag::STOPPING)
+        if !s.has(snapgen_host::protocol::flag::STOPPING)
             && matches!(axis, AxisState::Standstill | AxisState::ErrorStop)
         {
             break s;

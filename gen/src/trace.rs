@@ -7,7 +7,8 @@
 
 use std::io::{self, Write};
 
-use snapgen_model::{Plan, Quantity, Trace};
+use snapgen_model::{Quantity, Trace};
+use snapgen_plan::Plan;
 
 /// Writes the trace of `plan`, every `every`-th tick plus the last one.
 pub fn write_csv<W: Write>(plan: &Plan, every: u64, out: W) -> io::Result<u64> {

@@ -6,11 +6,12 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use snapgen_model::protocol::{
+use snapgen_host::protocol::{
     AxisState, Command as Cmd, Decoded, Decoder, ErrorId, Identity, Param, Reason, Reply,
     StateReply, Status,
 };
-use snapgen_model::{Format, Method, MoveRequest, DEFAULT_FORMAT};
+use snapgen_model::{Format, DEFAULT_FORMAT};
+use snapgen_plan::{Method, MoveRequest};
 
 /// The virtual board's Ts (its default design).
 const BOARD_TS: f64 = 1e-4;
@@ -144,7 +145,7 @@ fn moves_land_where_the_model_says(fabric: bool) {
     let id = board.identity(200);
     assert_eq!((id.clock_hz, id.tick_divider), (1_500_000, 149));
     assert_eq!(id.baud, 115_385, "1.5 MHz / 13 clocks per bit");
-    assert!(id.matches_format(&DEFAULT_FORMAT));
+    assert!(DEFAULT_FORMAT.matches_identity(&id));
     let f = Format::with_ts(BOARD_TS);
     let m = Method::Order3 {
         vmax: 0.5,
@@ -159,7 +160,7 @@ fn moves_land_where_the_model_says(fabric: bool) {
         assert!(text.contains("match the plan bit for bit"), "{text}");
         // The model, planned independently here with the board's Ts, ends on the same
         // registers, bit for bit.
-        let p = snapgen_model::plan_from(
+        let p = snapgen_plan::plan_from(
             &MoveRequest {
                 distance: distance.parse().unwrap(),
                 method: m,
@@ -174,7 +175,7 @@ fn moves_land_where_the_model_says(fabric: bool) {
         let s = board.status(202);
         assert_eq!((s.position, s.encoder), (cell, cell));
         assert_eq!(s.axis(), Some(AxisState::Standstill));
-        assert!(s.has(snapgen_model::protocol::flag::DONE));
+        assert!(s.has(snapgen_host::protocol::flag::DONE));
     }
     // The stop limits `send` configured read back as the plan's peaks.
     assert!(matches!(
@@ -282,7 +283,7 @@ fn corrupted_upload(fabric: bool) {
     std::thread::sleep(Duration::from_millis(100));
     let s = board.status(2);
     assert!(
-        !s.has(snapgen_model::protocol::flag::PLAYING),
+        !s.has(snapgen_host::protocol::flag::PLAYING),
         "a move started"
     );
     assert_eq!(s.bad_crc, 3, "three corrupted attempts were counted");
@@ -359,7 +360,7 @@ fn a_controlled_stop_ends_where_the_models_stop_does_on_the_fabric_and_the_model
         );
         let s = board.status(77);
         assert_eq!(s.axis(), Some(AxisState::Standstill));
-        assert!(s.has(snapgen_model::protocol::flag::CUT), "{s:?}");
+        assert!(s.has(snapgen_host::protocol::flag::CUT), "{s:?}");
         assert!(s.position > 0 && s.position < 200_000, "{s:?}");
         let st = board.state(78);
         assert_eq!((st.v, st.a, st.j), (0, 0, 0));
@@ -371,7 +372,7 @@ fn a_controlled_stop_ends_where_the_models_stop_does_on_the_fabric_and_the_model
 fn start_long_move(board: &Board, watchdog_ms: i128) -> u8 {
     use snapgen_model::format::Quantity;
     let f = Format::with_ts(BOARD_TS);
-    let p = snapgen_model::plan(
+    let p = snapgen_plan::plan(
         &MoveRequest {
             distance: 1.0,
             method: Method::Order3 {
@@ -443,7 +444,7 @@ fn a_host_that_dies_mid_move_is_stopped_by_the_watchdog() {
         (Some(AxisState::ErrorStop), Some(ErrorId::Watchdog)),
         "{s:?}"
     );
-    assert!(!s.has(snapgen_model::protocol::flag::PLAYING));
+    assert!(!s.has(snapgen_host::protocol::flag::PLAYING));
     let st = board.state(next());
     assert_eq!((st.v, st.a, st.j), (0, 0, 0), "at rest after the stop");
     assert!(s.position > 0 && s.position < 1_000_000, "{s:?}");
@@ -476,7 +477,7 @@ fn snapgen_stop_stops_a_move_in_progress() {
         "{text}"
     );
     let s = board.status(seq);
-    assert!(s.has(snapgen_model::protocol::flag::CUT), "{s:?}");
+    assert!(s.has(snapgen_host::protocol::flag::CUT), "{s:?}");
     assert!(s.position > 0 && s.position < 1_000_000, "{s:?}");
     let st = board.state(seq.wrapping_add(1).max(1));
     assert_eq!((st.v, st.a, st.j), (0, 0, 0));

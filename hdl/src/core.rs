@@ -30,174 +30,38 @@ use crate::sign_extend::CellCentre;
 use crate::stop_unit::StopUnit;
 use crate::swap_timer::{SwapTimer, SWAP_BITS};
 use crate::tick_divider::TickDivider;
-use crate::{
-    ADDR_BITS, A_BITS, D_BITS, FRAC, INDEX_BITS, J_BITS, POSITION_BITS, TICK_BITS, V_BITS, X_BITS,
-};
+use crate::{block_with_ports, FRAC, INDEX_BITS, POSITION_BITS};
 
 const _: () = assert!(FRAC == 80, "update the literal in MotionCore::update");
 
-/// The motion core (the top level of `snapgen verilog`).
-#[derive(LogicBlock)]
-pub struct MotionCore {
-    /// Fabric clock.
-    pub clock: Signal<In, Clock>,
-    /// Synchronous reset, active high.
-    pub reset: Signal<In, Bit>,
-    /// Clocks per tick minus one (0: a tick every clock).
-    pub tick_div: Signal<In, Bits<TICK_BITS>>,
-    /// Start the standby program (one-clock pulse; ignored while busy or stopping).
-    pub start: Signal<In, Bit>,
-    /// Emergency stop: sequencer idle, v = a = j = 0 now, position holds, stop cancelled.
-    pub abort_move: Signal<In, Bit>,
-    /// Controlled stop: taken on the next tick, ends at rest within the stop limits.
-    pub stop: Signal<In, Bit>,
-    /// The reference takes the encoder's position: x at the centre of cell `load_position`,
-    /// v = a = j = 0 (raised by the I/O top only at rest, with no program playing).
-    pub load: Signal<In, Bit>,
-    /// The cell for `load` (the encoder count).
-    pub load_position: Signal<In, Bits<POSITION_BITS>>,
-    /// The controlled stop's jerk limit, raw (> 0; latched when a stop is taken).
-    pub stop_jerk: Signal<In, Bits<D_BITS>>,
-    /// The controlled stop's acceleration limit, raw (≥ `stop_jerk`; latched likewise).
-    pub stop_accel: Signal<In, Bits<D_BITS>>,
-    /// Write one segment of the standby program.
-    pub write_enable: Signal<In, Bit>,
-    /// Segment address to write.
-    pub write_address: Signal<In, Bits<ADDR_BITS>>,
-    /// Segment tick count to write (≥ 1).
-    pub write_ticks: Signal<In, Bits<TICK_BITS>>,
-    /// Segment snap to write (two's complement).
-    pub write_snap: Signal<In, Bits<D_BITS>>,
-    /// Set the standby program's segment count.
-    pub count_enable: Signal<In, Bit>,
-    /// Segment count to set.
-    pub count_value: Signal<In, Bits<INDEX_BITS>>,
-    /// Arm a program swap (one-clock pulse; see [`crate::swap_timer`]).
-    pub swap: Signal<In, Bit>,
-    /// The low 32 bits of the time base on the old program's last tick: the registers at
-    /// `swap_last + 1` are the new program's start.
-    pub swap_last: Signal<In, Bits<SWAP_BITS>>,
-    /// Position register, raw.
-    pub x: Signal<Out, Bits<X_BITS>>,
-    /// Velocity register, raw.
-    pub v: Signal<Out, Bits<V_BITS>>,
-    /// Acceleration register, raw.
-    pub a: Signal<Out, Bits<A_BITS>>,
-    /// Jerk register, raw.
-    pub j: Signal<Out, Bits<J_BITS>>,
-    /// Position in whole output LSBs (`x >> FRAC`, low 32 bits).
-    pub position: Signal<Out, Bits<POSITION_BITS>>,
-    /// Segment playing.
-    pub segment: Signal<Out, Bits<INDEX_BITS>>,
-    /// A program is playing.
-    pub busy: Signal<Out, Bit>,
-    /// The last program ran to its end.
-    pub done: Signal<Out, Bit>,
-    /// The last program was cut short (by a stop or an abort).
-    pub aborted: Signal<Out, Bit>,
-    /// A controlled stop is requested or running.
-    pub stopping: Signal<Out, Bit>,
-    /// The last stop began outside its limits (and landed regardless of them).
-    pub stop_over: Signal<Out, Bit>,
-    /// Ticks since the start, while a program plays or a stop runs.
-    pub tick_count: Signal<Out, Bits<TICK_BITS>>,
-    /// Ticks since reset: the board's time base.
-    pub ticks: Signal<Out, Bits<64>>,
-    /// The axis heads forward (registered): on the last clock the first non-zero of v, a, j
-    /// was positive.
-    pub heading_pos: Signal<Out, Bit>,
-    /// The axis heads backward (registered).
-    pub heading_neg: Signal<Out, Bit>,
-    /// The chain is at rest: v = a = j = 0.
-    pub at_rest: Signal<Out, Bit>,
-    /// The tick enable (one clock wide).
-    pub tick: Signal<Out, Bit>,
-    /// Bank that plays (the other one is written).
-    pub active_bank: Signal<Out, Bit>,
-    /// Segment count of the standby program (0: nothing to start).
-    pub standby_count: Signal<Out, Bits<INDEX_BITS>>,
-    /// A program swap is armed.
-    pub swap_pending: Signal<Out, Bit>,
-    divider: TickDivider,
-    swap_timer: SwapTimer,
-    memory: ProgramMemory,
-    sequencer: Sequencer,
-    chain: SnapChain,
-    cell_centre: CellCentre,
-    stop_unit: StopUnit,
-    bank: DFF<Bit>,
-    count0: DFF<Bits<INDEX_BITS>>,
-    count1: DFF<Bits<INDEX_BITS>>,
-    aborted_reg: DFF<Bit>,
-    ticks_reg: DFF<Bits<64>>,
-    read_bank: Signal<Local, Bit>,
-    engage: Signal<Local, Bit>,
-    ticks_next: Signal<Local, Bits<64>>,
-    count_zero: Constant<Bits<INDEX_BITS>>,
-    ticks_zero: Constant<Bits<64>>,
-    ticks_one: Constant<Bits<64>>,
-}
+snapgen_spec::with_motion_core_ports!(block_with_ports! {
+    /// The motion core (the top level of `snapgen verilog`); its ports are the spec's
+    /// `with_motion_core_ports!` list.
+    pub struct MotionCore() {
+        divider: TickDivider = Default::default(),
+        swap_timer: SwapTimer = Default::default(),
+        memory: ProgramMemory = Default::default(),
+        sequencer: Sequencer = Default::default(),
+        chain: SnapChain = Default::default(),
+        cell_centre: CellCentre = Default::default(),
+        stop_unit: StopUnit = Default::default(),
+        bank: DFF<Bit> = Default::default(),
+        count0: DFF<Bits<INDEX_BITS>> = Default::default(),
+        count1: DFF<Bits<INDEX_BITS>> = Default::default(),
+        aborted_reg: DFF<Bit> = Default::default(),
+        ticks_reg: DFF<Bits<64>> = Default::default(),
+        read_bank: Signal<Local, Bit> = Default::default(),
+        engage: Signal<Local, Bit> = Default::default(),
+        ticks_next: Signal<Local, Bits<64>> = Default::default(),
+        count_zero: Constant<Bits<INDEX_BITS>> = Constant::new(0.into()),
+        ticks_zero: Constant<Bits<64>> = Constant::new(0.into()),
+        ticks_one: Constant<Bits<64>> = Constant::new(1.into()),
+    }
+});
 
 impl Default for MotionCore {
     fn default() -> Self {
-        MotionCore {
-            clock: Default::default(),
-            reset: Default::default(),
-            tick_div: Default::default(),
-            start: Default::default(),
-            abort_move: Default::default(),
-            stop: Default::default(),
-            load: Default::default(),
-            load_position: Default::default(),
-            stop_jerk: Default::default(),
-            stop_accel: Default::default(),
-            write_enable: Default::default(),
-            write_address: Default::default(),
-            write_ticks: Default::default(),
-            write_snap: Default::default(),
-            count_enable: Default::default(),
-            count_value: Default::default(),
-            swap: Default::default(),
-            swap_last: Default::default(),
-            x: Default::default(),
-            v: Default::default(),
-            a: Default::default(),
-            j: Default::default(),
-            position: Default::default(),
-            segment: Default::default(),
-            busy: Default::default(),
-            done: Default::default(),
-            aborted: Default::default(),
-            stopping: Default::default(),
-            stop_over: Default::default(),
-            tick_count: Default::default(),
-            ticks: Default::default(),
-            heading_pos: Default::default(),
-            heading_neg: Default::default(),
-            at_rest: Default::default(),
-            tick: Default::default(),
-            active_bank: Default::default(),
-            standby_count: Default::default(),
-            swap_pending: Default::default(),
-            divider: Default::default(),
-            swap_timer: Default::default(),
-            memory: Default::default(),
-            sequencer: Default::default(),
-            chain: Default::default(),
-            cell_centre: Default::default(),
-            stop_unit: Default::default(),
-            bank: Default::default(),
-            count0: Default::default(),
-            count1: Default::default(),
-            aborted_reg: Default::default(),
-            ticks_reg: Default::default(),
-            read_bank: Default::default(),
-            engage: Default::default(),
-            ticks_next: Default::default(),
-            count_zero: Constant::new(0.into()),
-            ticks_zero: Constant::new(0.into()),
-            ticks_one: Constant::new(1.into()),
-        }
+        MotionCore::build()
     }
 }
 

@@ -5,7 +5,7 @@
 //! ([`crc16_function`]).
 
 use rust_hdl::prelude::*;
-use snapgen_model::protocol::{crc16_step, CRC_POLY};
+use snapgen_spec::wire::{crc16_step, CRC_POLY};
 
 /// CRC-16/CCITT-FALSE byte step.
 #[derive(LogicBlock, Default)]

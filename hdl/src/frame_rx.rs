@@ -5,7 +5,7 @@
 //! `timeout` clocks, or by a UART framing error, is dropped with a `dropped` pulse.
 
 use rust_hdl::prelude::*;
-use snapgen_model::protocol::{CRC_INIT, DEVICE_MAX_PAYLOAD, START};
+use snapgen_spec::wire::{CRC_INIT, DEVICE_MAX_PAYLOAD, START};
 
 use crate::crc16::Crc16Step;
 use crate::payload_shift::PayloadShift;

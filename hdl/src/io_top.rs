@@ -19,9 +19,10 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::device::Design;
-use snapgen_model::protocol::AxisState;
 use snapgen_model::timing::{Dividers, Timing};
+use snapgen_spec::AxisState;
 
+use crate::block_with_ports;
 use crate::byte_fifo::ByteFifo;
 use crate::core::MotionCore;
 use crate::executor::Executor;
@@ -32,7 +33,7 @@ use crate::quadrature::QuadratureDecoder;
 use crate::reply_queue::ReplyQueue;
 use crate::reply_tx::ReplyTx;
 use crate::servo::Servo;
-use crate::status_block::{StatusBlock, STATUS_BITS};
+use crate::status_block::{FlagsWord, StatusBlock};
 use crate::uart_rx::UartRx;
 use crate::uart_tx::UartTx;
 use crate::verilog::{Note, Waiver};
@@ -109,128 +110,45 @@ pub fn default_design() -> Design {
     }
 }
 
-/// The I/O top.
-#[derive(LogicBlock)]
-pub struct IoTop {
-    /// Fabric clock.
-    pub clock: Signal<In, Clock>,
-    /// Synchronous reset, active high.
-    pub reset: Signal<In, Bit>,
-    /// UART receive pin.
-    pub uart_rx: Signal<In, Bit>,
-    /// Encoder channel A.
-    pub enc_a: Signal<In, Bit>,
-    /// Encoder channel B.
-    pub enc_b: Signal<In, Bit>,
-    /// Encoder index.
-    pub enc_i: Signal<In, Bit>,
-    /// Positive limit switch (polarity set by INPUT_POLARITY).
-    pub limit_pos: Signal<In, Bit>,
-    /// Negative limit switch.
-    pub limit_neg: Signal<In, Bit>,
-    /// Emergency stop.
-    pub estop: Signal<In, Bit>,
-    /// UART transmit pin.
-    pub uart_tx: Signal<Out, Bit>,
-    /// PWM output.
-    pub pwm: Signal<Out, Bit>,
-    /// Direction output.
-    pub dir: Signal<Out, Bit>,
-    /// Amplifier enable (low: the amplifier must not drive the motor).
-    pub amplifier: Signal<Out, Bit>,
-    /// LED 0: idle.
-    pub led_idle: Signal<Out, Bit>,
-    /// LED 1: busy.
-    pub led_busy: Signal<Out, Bit>,
-    /// LED 2: fault.
-    pub led_fault: Signal<Out, Bit>,
-    /// LED 3: heartbeat.
-    pub led_heartbeat: Signal<Out, Bit>,
-    /// The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits
-    /// 7:0: for co-simulation and debugging.
-    pub status: Signal<Out, Bits<STATUS_BITS>>,
-    uart_in: UartRx,
-    rx_fifo: ByteFifo,
-    frames: FrameRx,
-    exec: Executor,
-    core: MotionCore,
-    queue: ReplyQueue,
-    reply_tx: ReplyTx,
-    tx_fifo: ByteFifo,
-    uart_out: UartTx,
-    encoder: QuadratureDecoder<32>,
-    pwm_gen: PwmGenerator,
-    servo: Servo,
-    status_block: StatusBlock,
-    limit_pos_in: InputFilter,
-    limit_neg_in: InputFilter,
-    estop_in: InputFilter,
-    heartbeat: DFF<Bits<32>>,
-    limit_pos_seen: Signal<Local, Bit>,
-    limit_neg_seen: Signal<Local, Bit>,
-    estop_seen: Signal<Local, Bit>,
-    encoder_error: Signal<Local, Bit>,
-    divisor: Constant<Bits<16>>,
-    timeout: Constant<Bits<32>>,
-    beat_mask: Constant<Bits<32>>,
-    one: Constant<Bits<32>>,
-    zero32: Constant<Bits<32>>,
-    zero16: Constant<Bits<16>>,
-    error_stop: Constant<Bits<3>>,
-}
+snapgen_spec::with_io_top_ports!(block_with_ports! {
+    /// The I/O top; its ports are the spec's `with_io_top_ports!` list.
+    pub struct IoTop(design: Design) {
+        uart_in: UartRx = Default::default(),
+        rx_fifo: ByteFifo = Default::default(),
+        frames: FrameRx = Default::default(),
+        exec: Executor = Executor::new(design.dividers, design.input_polarity),
+        core: MotionCore = Default::default(),
+        queue: ReplyQueue = Default::default(),
+        reply_tx: ReplyTx = ReplyTx::new(design.identity()),
+        tx_fifo: ByteFifo = Default::default(),
+        uart_out: UartTx = Default::default(),
+        encoder: QuadratureDecoder<32> = Default::default(),
+        pwm_gen: PwmGenerator = Default::default(),
+        servo: Servo = Default::default(),
+        flags_word: FlagsWord = Default::default(),
+        status_block: StatusBlock = Default::default(),
+        limit_pos_in: InputFilter = InputFilter::new(false),
+        limit_neg_in: InputFilter = InputFilter::new(false),
+        estop_in: InputFilter = InputFilter::new(false),
+        heartbeat: DFF<Bits<32>> = Default::default(),
+        limit_pos_seen: Signal<Local, Bit> = Default::default(),
+        limit_neg_seen: Signal<Local, Bit> = Default::default(),
+        estop_seen: Signal<Local, Bit> = Default::default(),
+        encoder_error: Signal<Local, Bit> = Default::default(),
+        divisor: Constant<Bits<16>> = Constant::new(u64::from(design.dividers.uart_divisor).into()),
+        timeout: Constant<Bits<32>> = Constant::new(u64::from(design.dividers.frame_timeout).into()),
+        beat_mask: Constant<Bits<32>> = Constant::new((1u64 << design.dividers.heartbeat_bit).into()),
+        one: Constant<Bits<32>> = Constant::new(1.into()),
+        zero32: Constant<Bits<32>> = Constant::new(0.into()),
+        zero16: Constant<Bits<16>> = Constant::new(0.into()),
+        error_stop: Constant<Bits<8>> = Constant::new((AxisState::ErrorStop as u64).into()),
+    }
+});
 
 impl IoTop {
     /// The top for `design` (its dividers, and its identity for PING).
     pub fn new(design: Design) -> Self {
-        let cfg = design.dividers;
-        IoTop {
-            clock: Default::default(),
-            reset: Default::default(),
-            uart_rx: Default::default(),
-            enc_a: Default::default(),
-            enc_b: Default::default(),
-            enc_i: Default::default(),
-            limit_pos: Default::default(),
-            limit_neg: Default::default(),
-            estop: Default::default(),
-            uart_tx: Default::default(),
-            pwm: Default::default(),
-            dir: Default::default(),
-            amplifier: Default::default(),
-            led_idle: Default::default(),
-            led_busy: Default::default(),
-            led_fault: Default::default(),
-            led_heartbeat: Default::default(),
-            status: Default::default(),
-            uart_in: Default::default(),
-            rx_fifo: Default::default(),
-            frames: Default::default(),
-            exec: Executor::new(cfg, design.input_polarity),
-            core: Default::default(),
-            queue: Default::default(),
-            reply_tx: ReplyTx::new(design.identity()),
-            tx_fifo: Default::default(),
-            uart_out: Default::default(),
-            encoder: Default::default(),
-            pwm_gen: Default::default(),
-            servo: Default::default(),
-            status_block: Default::default(),
-            limit_pos_in: InputFilter::new(false),
-            limit_neg_in: InputFilter::new(false),
-            estop_in: InputFilter::new(false),
-            heartbeat: Default::default(),
-            limit_pos_seen: Default::default(),
-            limit_neg_seen: Default::default(),
-            estop_seen: Default::default(),
-            encoder_error: Default::default(),
-            divisor: Constant::new(u64::from(cfg.uart_divisor).into()),
-            timeout: Constant::new(u64::from(cfg.frame_timeout).into()),
-            beat_mask: Constant::new((1u64 << cfg.heartbeat_bit).into()),
-            one: Constant::new(1.into()),
-            zero32: Constant::new(0.into()),
-            zero16: Constant::new(0.into()),
-            error_stop: Constant::new((AxisState::ErrorStop as u64).into()),
-        }
+        IoTop::build(design)
     }
 }
 
@@ -319,7 +237,7 @@ impl Logic for IoTop {
         self.exec.estop.next = self.estop_seen.val();
         // Motion core.
         self.core.reset.next = self.reset.val();
-        self.core.tick_div.next = self.exec.tick_div.val();
+        self.core.tick_div.next = self.exec.tick_divider.val();
         self.core.start.next = self.exec.start.val();
         self.core.swap.next = self.exec.swap.val();
         self.core.swap_last.next = self.exec.swap_last.val();
@@ -343,25 +261,24 @@ impl Logic for IoTop {
         self.encoder.clear.next = self.reset.val();
         // Encoder errors since reset or the last RESET command.
         self.encoder_error.next = self.encoder.errors.val() != self.exec.encoder_errors_seen.val();
-        // The status block.
+        // The status block: its flags, then its fields.
+        self.flags_word.playing.next = self.core.busy.val();
+        self.flags_word.done.next = self.core.done.val();
+        self.flags_word.cut.next = self.core.aborted.val();
+        self.flags_word.stopping.next = self.core.stopping.val();
+        self.flags_word.stop_over.next = self.core.stop_over.val();
+        self.flags_word.amplifier.next = self.exec.amplifier.val();
+        self.flags_word.limit_pos.next = self.limit_pos_seen.val();
+        self.flags_word.limit_neg.next = self.limit_neg_seen.val();
+        self.flags_word.estop.next = self.estop_seen.val();
+        self.flags_word.encoder_error.next = self.encoder_error.val();
+        self.flags_word.uart_error.next = self.exec.uart_error.val();
+        self.flags_word.reply_overflow.next = self.exec.reply_overflow.val();
+        self.flags_word.servo_overrun.next = self.exec.servo_overrun.val();
+        self.flags_word.swap_pending.next = self.core.swap_pending.val();
         self.status_block.state.next = self.exec.state.val();
         self.status_block.error.next = self.exec.error.val();
-        self.status_block.playing.next = self.core.busy.val();
-        self.status_block.done.next = self.core.done.val();
-        self.status_block.cut.next = self.core.aborted.val();
-        self.status_block.stopping.next = self.core.stopping.val();
-        self.status_block.stop_over.next = self.core.stop_over.val();
-        self.status_block.amplifier.next = self.exec.amplifier.val();
-        self.status_block.limit_pos.next = self.limit_pos_seen.val();
-        self.status_block.limit_neg.next = self.limit_neg_seen.val();
-        self.status_block.estop.next = self.estop_seen.val();
-        self.status_block.encoder_error.next = self.encoder_error.val();
-        self.status_block.uart_error.next = self.exec.uart_error.val();
-        self.status_block.reply_overflow.next = self.exec.reply_overflow.val();
-        self.status_block.servo_overrun.next = self.exec.servo_overrun.val();
-        self.status_block.swap_pending.next = self.core.swap_pending.val();
-        self.status_block.following_peak.next = self.servo.peak.val();
-        self.status_block.duty.next = self.servo.duty.val();
+        self.status_block.flags.next = self.flags_word.flags.val();
         self.status_block.tick_count.next = self.core.tick_count.val();
         self.status_block.position.next = self.core.position.val();
         // rust-hdl workaround: the bit index is a literal (`#[hdl_gen]` copies const names
@@ -370,6 +287,8 @@ impl Logic for IoTop {
         self.status_block.encoder.next = self.encoder.count.val();
         self.status_block.bad_crc.next = self.exec.bad_crc_count.val();
         self.status_block.bad_frames.next = self.exec.bad_frames_count.val();
+        self.status_block.following_peak.next = self.servo.peak.val();
+        self.status_block.duty.next = self.servo.duty.val();
         self.status.next = self.status_block.status.val();
         // Replies and telemetry.
         self.queue.reset.next = self.reset.val();
@@ -388,7 +307,7 @@ impl Logic for IoTop {
         self.reply_tx.telemetry.next = self.exec.telemetry.val();
         self.reply_tx.fifo_full.next = self.tx_fifo.full.val();
         self.reply_tx.status.next = self.status_block.status.val();
-        self.reply_tx.tick_div.next = self.exec.tick_div.val();
+        self.reply_tx.tick_divider.next = self.exec.tick_divider.val();
         self.reply_tx.stop_jerk.next = self.exec.stop_jerk.val();
         self.reply_tx.stop_accel.next = self.exec.stop_accel.val();
         self.reply_tx.config_value.next = self.exec.read_value.val();
@@ -418,7 +337,7 @@ impl Logic for IoTop {
         self.servo.velocity.next = self.core.v.val().get_bits::<56>(48);
         self.servo.accel.next = self.core.a.val().get_bits::<64>(40);
         self.servo.count.next = self.encoder.count.val();
-        self.servo.period.next = self.exec.servo_period.val();
+        self.servo.servo_period.next = self.exec.servo_period.val();
         self.servo.kp.next = self.exec.kp.val();
         self.servo.ki.next = self.exec.ki.val();
         self.servo.kd.next = self.exec.kd.val();

@@ -5,10 +5,11 @@
 //! (plays a program, one snap value per tick), [`chain`] (the four accumulators) and
 //! [`core`] (all of them wired together, the top level that `snapgen verilog` writes).
 //!
-//! Widths come from the model's [`DEFAULT_FORMAT`]: there is no second copy of the numbers.
-//! rust-hdl needs widths as const generics, so the generator supports the default register
-//! widths only; `Ts` and the position LSB do not change the hardware (the tick divider is an
-//! input).
+//! Widths and port lists come from the contract (`snapgen_spec`): the blocks whose ports cross
+//! a boundary (the motion core, the I/O top) declare them with [`block_with_ports!`] from the
+//! spec's lists, so there is no second copy of a port or a width. rust-hdl needs widths as
+//! const generics, so the generator supports the spec's register widths only; `Ts` and the
+//! position LSB do not change the hardware (the tick divider is an input).
 //!
 //! rust-hdl 0.46 workarounds used here (each is also noted where it is applied):
 //! * `#[hdl_gen]` drops Rust's operator precedence: every mixed expression is parenthesised.
@@ -41,41 +42,88 @@ pub mod sim_bits;
 pub mod status_block;
 pub mod stop_unit;
 pub mod swap_timer;
+pub mod template;
 pub mod tick_divider;
 pub mod uart_rx;
 pub mod uart_tx;
 pub mod verilog;
 
-use snapgen_model::{DEFAULT_FORMAT, FRAC_BITS};
+use snapgen_spec::widths;
 
 /// Position register width.
-pub const X_BITS: usize = DEFAULT_FORMAT.widths.x as usize;
+pub const X_BITS: usize = widths::X_BITS as usize;
 /// Velocity register width.
-pub const V_BITS: usize = DEFAULT_FORMAT.widths.v as usize;
+pub const V_BITS: usize = widths::V_BITS as usize;
 /// Acceleration register width.
-pub const A_BITS: usize = DEFAULT_FORMAT.widths.a as usize;
+pub const A_BITS: usize = widths::A_BITS as usize;
 /// Jerk register width.
-pub const J_BITS: usize = DEFAULT_FORMAT.widths.j as usize;
+pub const J_BITS: usize = widths::J_BITS as usize;
 /// Snap (segment value) width.
-pub const D_BITS: usize = DEFAULT_FORMAT.widths.d as usize;
+pub const D_BITS: usize = widths::D_BITS as usize;
 /// Segment tick count and tick counter width.
-pub const TICK_BITS: usize = DEFAULT_FORMAT.tick_bits as usize;
+pub const TICK_BITS: usize = widths::TICK_BITS as usize;
 /// Fractional bits of the position register below the output LSB.
-pub const FRAC: usize = FRAC_BITS as usize;
-/// Width of the whole-LSB position output (`x >> FRAC`, truncated to 32 bits).
-pub const POSITION_BITS: usize = 32;
+pub const FRAC: usize = widths::FRAC_BITS as usize;
+/// Width of the whole-LSB position output (`x >> FRAC`, truncated).
+pub const POSITION_BITS: usize = widths::POSITION_BITS as usize;
 /// Segment address within a bank: `max_segments` = 2^ADDR_BITS.
-pub const ADDR_BITS: usize = 5;
+pub const ADDR_BITS: usize = widths::ADDR_BITS as usize;
 /// Segment index and count width (holds 0..=2^ADDR_BITS).
-pub const INDEX_BITS: usize = ADDR_BITS + 1;
+pub const INDEX_BITS: usize = widths::INDEX_BITS as usize;
 /// Memory address: bank bit and segment address.
 pub const MEM_ADDR_BITS: usize = ADDR_BITS + 1;
 
+/// A port's rust-hdl type from its kind and width in a `snapgen_spec` port list.
+macro_rules! hdl_type {
+    (bit, $b:expr) => {
+        Bit
+    };
+    (bits, $b:expr) => {
+        Bits<{ ($b) as usize }>
+    };
+}
+pub(crate) use hdl_type;
+
+/// A rust-hdl block whose ports are a `snapgen_spec` port list (called through
+/// `with_motion_core_ports!` or `with_io_top_ports!`): the struct, with the ports first, each
+/// with its list's doc line, then `$children`; and `fn build($args) -> Self`, which makes each
+/// child from its expression (which may use the arguments).
+macro_rules! block_with_ports {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident ( $( $arg:ident : $aty:ty ),* ) {
+            $( $(#[$cm:meta])* $child:ident : $cty:ty = $init:expr ),* $(,)?
+        }
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        $(#[$meta])*
+        #[derive(LogicBlock)]
+        pub struct $name {
+            #[doc = $cdoc]
+            pub clock: Signal<In, Clock>,
+            $( $( #[doc = $idoc] pub $i: Signal<In, $crate::hdl_type!($ik, $ib)>, )* )*
+            $( $( #[doc = $odoc] pub $o: Signal<Out, $crate::hdl_type!($ok, $ob)>, )* )*
+            $( $(#[$cm])* $child: $cty, )*
+        }
+
+        impl $name {
+            /// The block, every port at its default, every child made from its expression.
+            fn build($( $arg: $aty ),*) -> Self {
+                $name {
+                    clock: Default::default(),
+                    $( $( $i: Default::default(), )* )*
+                    $( $( $o: Default::default(), )* )*
+                    $( $child: $init, )*
+                }
+            }
+        }
+    };
+}
+pub(crate) use block_with_ports;
+
 const _: () = {
-    assert!(
-        DEFAULT_FORMAT.max_segments == 1 << ADDR_BITS,
-        "the program memory depth must equal the format's max_segments"
-    );
     assert!(
         V_BITS == A_BITS && A_BITS == J_BITS && J_BITS == D_BITS,
         "the generator supports equal v, a, j, d widths (sign extension is only into x)"

@@ -9,22 +9,24 @@
 //! rust-hdl's simulator.
 
 use rust_hdl::prelude::*;
-use snapgen_model::protocol::COMMANDS;
+use snapgen_spec::COMMANDS;
 
 use crate::sim_bits::from_u128;
 
 /// Payload bytes kept: the longest command payload.
-pub const PAYLOAD_BYTES: usize = 18;
-/// Their bits.
-pub const PAYLOAD_BITS: usize = 8 * PAYLOAD_BYTES;
-
-const _: () = {
+pub const PAYLOAD_BYTES: usize = {
+    let mut most = 0;
     let mut k = 0;
     while k < COMMANDS.len() {
-        assert!(COMMANDS[k].len as usize <= PAYLOAD_BYTES);
+        if COMMANDS[k].len as usize > most {
+            most = COMMANDS[k].len as usize;
+        }
         k += 1;
     }
+    most
 };
+/// Their bits.
+pub const PAYLOAD_BITS: usize = 8 * PAYLOAD_BYTES;
 
 /// Payload shift register and received CRC.
 #[derive(LogicBlock, Default)]

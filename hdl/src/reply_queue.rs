@@ -9,7 +9,7 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::io::executor::{ReplyDesc, ReplyKind, ReplyQueue as QueueModel};
-use snapgen_model::protocol::REPLY_QUEUE;
+use snapgen_spec::rules::REPLY_QUEUE;
 
 use crate::protocol_v::KIND_BITS;
 

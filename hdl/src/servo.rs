@@ -32,9 +32,15 @@
 //! 125 MHz clock allows.)
 
 use rust_hdl::prelude::*;
-use snapgen_model::io::servo::{A_SHIFT, E_FRAC, GAIN_BITS, LATENCY, OUT_SHIFT, V_SHIFT};
+use snapgen_model::io::servo::{
+    ServoConfig, A_SHIFT, E_FRAC, GAIN_BITS, LATENCY, OUT_SHIFT, V_SHIFT,
+};
 
 use crate::sim_bits::to_u128;
+use crate::template::{fill, Holes};
+
+/// The controller's template.
+const TEMPLATE: &str = include_str!("../verilog/servo.v");
 use crate::{A_BITS, POSITION_BITS, V_BITS, X_BITS};
 
 /// The slices of the chain's registers the controller reads: `ref_position = x[111:64]`,
@@ -62,57 +68,72 @@ const _: () = {
     );
 };
 
-/// The controller.
-#[derive(LogicBlock, Default)]
-pub struct Servo {
-    /// Fabric clock.
-    pub clock: Signal<In, Clock>,
-    /// Synchronous reset.
-    pub reset: Signal<In, Bit>,
-    /// The amplifier is enabled (otherwise everything but the peak clears).
-    pub enable: Signal<In, Bit>,
-    /// The core's tick enable.
-    pub tick: Signal<In, Bit>,
-    /// A program starts: the peak error clears.
-    pub start: Signal<In, Bit>,
-    /// The reference position: the position register's bits 111:64 (counts · 2^-16).
-    pub ref_position: Signal<In, Bits<48>>,
-    /// The velocity register's bits 103:48 (counts/tick · 2^-32).
-    pub velocity: Signal<In, Bits<56>>,
-    /// The acceleration register's bits 103:40 (counts/tick² · 2^-40).
-    pub accel: Signal<In, Bits<64>>,
-    /// Encoder count.
-    pub count: Signal<In, Bits<POSITION_BITS>>,
-    /// SERVO_PERIOD (ticks per sample; 0: off).
-    pub period: Signal<In, Bits<16>>,
-    /// KP.
-    pub kp: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// KI.
-    pub ki: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// KD.
-    pub kd: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// KV.
-    pub kv: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// KA.
-    pub ka: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// INTEGRAL_LIMIT.
-    pub integral_limit: Signal<In, Bits<GAIN_REG_BITS>>,
-    /// OUTPUT_LIMIT.
-    pub output_limit: Signal<In, Bits<16>>,
-    /// FOLLOWING_LIMIT (counts).
-    pub following_limit: Signal<In, Bits<32>>,
-    /// D_FILTER (the derivative filter's shift).
-    pub d_filter: Signal<In, Bits<4>>,
-    /// Duty (two's complement, PWM clocks).
-    pub duty: Signal<Out, Bits<16>>,
-    /// Pulse: the following error is beyond its limit.
-    pub fault: Signal<Out, Bit>,
-    /// Pulse: a sample was skipped.
-    pub overrun: Signal<Out, Bit>,
-    /// Peak |following error| since START (counts · 2^-16).
-    pub peak: Signal<Out, Bits<32>>,
-    _rtl: Rtl,
+/// The controller's ports: its own, then the `servo` group of the parameters (from the
+/// contract's list: one input per parameter, named as its register).
+macro_rules! servo_block {
+    (
+        own {
+            inputs { $( $(#[$im:meta])* $i:ident : $it:ty, )* }
+            outputs { $( $(#[$om:meta])* $o:ident : $ot:ty, )* }
+        }
+        core { $($c:tt)* }
+        io { $($io:tt)* }
+        host { $($h:tt)* }
+        servo { $( $var:ident = $code:literal, $name:literal, $reg:ident : $ty:ty, $bits:expr,
+            $sign:ident, $reset:ident $(($rv:expr))?, $settable:ident, $meaning:literal; )* }
+    ) => {
+        /// The controller.
+        #[derive(LogicBlock, Default)]
+        pub struct Servo {
+            /// Fabric clock.
+            pub clock: Signal<In, Clock>,
+            $( $(#[$im])* pub $i: Signal<In, $it>, )*
+            $( #[doc = $name] pub $reg: Signal<In, Bits<{ ($bits) as usize }>>, )*
+            $( $(#[$om])* pub $o: Signal<Out, $ot>, )*
+            _rtl: Rtl,
+        }
+
+        impl Servo {
+            /// The configuration on the ports.
+            fn config(&self) -> ServoConfig {
+                ServoConfig { $( $reg: self.$reg.val().to_u64() as $ty, )* }
+            }
+        }
+    };
 }
+
+snapgen_spec::with_params!(servo_block! {
+    own {
+        inputs {
+            /// Synchronous reset.
+            reset: Bit,
+            /// The amplifier is enabled (otherwise everything but the peak clears).
+            enable: Bit,
+            /// The core's tick enable.
+            tick: Bit,
+            /// A program starts: the peak error clears.
+            start: Bit,
+            /// The reference position: the position register's bits 111:64 (counts · 2^-16).
+            ref_position: Bits<48>,
+            /// The velocity register's bits 103:48 (counts/tick · 2^-32).
+            velocity: Bits<56>,
+            /// The acceleration register's bits 103:40 (counts/tick² · 2^-40).
+            accel: Bits<64>,
+            /// Encoder count.
+            count: Bits<POSITION_BITS>,
+        }
+        outputs {
+            /// Duty (two's complement, PWM clocks).
+            duty: Bits<16>,
+            /// Pulse: the following error is beyond its limit.
+            fault: Bit,
+            /// Pulse: a sample was skipped.
+            overrun: Bit,
+            /// Peak |following error| since START (counts · 2^-16).
+            peak: Bits<32>,
+        }
+    }
+});
 
 /// The register-level design, in Rust (what the Verilog below is): every register, and the
 /// same statements per clock.
@@ -177,12 +198,7 @@ struct Ports {
     velocity: u64,
     accel: u64,
     count: u32,
-    period: u16,
-    gains: [u64; 5],
-    integral_limit: u64,
-    output_limit: u16,
-    following_limit: u32,
-    d_filter: u8,
+    config: ServoConfig,
 }
 
 impl Rtl {
@@ -213,10 +229,11 @@ impl Rtl {
             *self = n;
             return;
         }
-        let due = p.tick && p.period != 0 && self.divider == 0;
-        if p.tick && p.period != 0 {
+        let c = &p.config;
+        let due = p.tick && c.servo_period != 0 && self.divider == 0;
+        if p.tick && c.servo_period != 0 {
             n.divider = if self.divider == 0 {
-                p.period - 1
+                c.servo_period - 1
             } else {
                 self.divider - 1
             };
@@ -229,11 +246,11 @@ impl Rtl {
             n.e48 = p.ref_position.wrapping_sub(centre) & ((1 << 48) - 1);
             n.vs = p.velocity;
             n.as_ = p.accel;
-            n.gains = p.gains;
-            n.integral_limit = p.integral_limit;
-            n.output_limit = p.output_limit;
-            n.following_limit = p.following_limit;
-            n.d_filter = p.d_filter;
+            n.gains = [c.kp, c.ki, c.kd, c.kv, c.ka].map(|g| g as u64);
+            n.integral_limit = c.integral_limit as u64;
+            n.output_limit = c.output_limit;
+            n.following_limit = c.following_limit;
+            n.d_filter = c.d_filter;
             n.busy = true;
             n.step0 = true;
         }
@@ -323,7 +340,6 @@ impl Rtl {
 impl Logic for Servo {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let g = |s: &Signal<In, Bits<GAIN_REG_BITS>>| s.val().to_u64();
             let p = Ports {
                 reset: self.reset.val(),
                 enable: self.enable.val(),
@@ -333,18 +349,7 @@ impl Logic for Servo {
                 velocity: self.velocity.val().to_u64(),
                 accel: to_u128(self.accel.val()) as u64,
                 count: self.count.val().to_u64() as u32,
-                period: self.period.val().to_u64() as u16,
-                gains: [
-                    g(&self.kp),
-                    g(&self.ki),
-                    g(&self.kd),
-                    g(&self.kv),
-                    g(&self.ka),
-                ],
-                integral_limit: g(&self.integral_limit),
-                output_limit: self.output_limit.val().to_u64() as u16,
-                following_limit: self.following_limit.val().to_u64() as u32,
-                d_filter: self.d_filter.val().to_u64() as u8,
+                config: self.config(),
             };
             self._rtl.clock(&p);
         }
@@ -369,208 +374,19 @@ impl Logic for Servo {
 
 /// The controller's Verilog body.
 pub fn servo_verilog() -> String {
-    format!(
-        r#"
-// Fixed point (snapgen_model::io::servo): e in counts * 2^-{e_frac}, vs = v >>> {v_shift},
-// as = a >>> {a_shift}, u = (sum + 2^{half}) >>> {out_shift}; {latency} clocks from sample to duty.
-reg [15:0] divider = 16'd0;          // ticks to the next sample
-reg busy = 1'b0;
-reg step0 = 1'b0;                    // the first clock after a sample
-reg [2:0] term = 3'd0;               // 0 e, 1 I, 2 D, 3 vs, 4 as
-reg [2:0] digit = 3'd0;              // 0..{last_digit}: a gain digit's products; 1..{digits}: their
-                                     // addition a clock later; {sum_clock}: into the sum
-reg fin = 1'b0;                      // the last clock: round and saturate
-reg [47:0] e48_q = 48'd0;            // the sample's following error
-reg [55:0] vs_q = 56'd0;             // v[103:48]
-reg [63:0] as_q = 64'd0;             // a[103:40]
-reg [47:0] f_q = 48'd0;              // the derivative filter's state F (the operand: F >>> k)
-reg [47:0] i_q = 48'd0;              // the integrator
-reg [31:0] eprev_q = 32'd0;
-reg primed = 1'b0;                   // a sample since the amplifier came on
-reg sat_hi = 1'b0, sat_lo = 1'b0;    // the last output was clamped
-reg [63:0] mag_q = 64'd0;            // the term's operand: magnitude, sign
-reg neg_q = 1'b0;
-reg [47:0] gain_q = 48'd0;           // the term's gain
-reg [111:0] acc_q = 112'd0;          // gain * |operand|, digit by digit
-reg [31:0] p0 = 32'd0, p1 = 32'd0, p2 = 32'd0, p3 = 32'd0;   // a digit's products, registered
-/* verilator lint_off UNUSEDSIGNAL */ // the fraction below bit 47 is what the rounding drops
-reg [115:0] sum_q = 116'd0;          // the terms so far (two's complement)
-/* verilator lint_on UNUSEDSIGNAL */
-// The configuration latched at the sample (a CONFIGURE meanwhile waits for the next sample).
-reg [47:0] kp_q = 48'd0, ki_q = 48'd0, kd_q = 48'd0, kv_q = 48'd0, ka_q = 48'd0;
-reg [47:0] ilim_q = 48'd0;
-reg [15:0] olim_q = 16'd0;
-reg [31:0] flim_q = 32'd0;
-reg [3:0] dfk_q = 4'd0;
-reg [15:0] duty_q = 16'd0;
-reg fault_q = 1'b0, overrun_q = 1'b0;
-reg [31:0] peak_q = 32'd0;
-
-// The sample's error.
-wire due = tick && (period != 16'd0) && (divider == 16'd0);
-wire [47:0] e48_now = ref_position - {{count, 16'h8000}};   // count n: the centre of cell n
-
-// Step 0: saturation, following check, D and the integrator.
-wire e_sat_hi = !e48_q[47] && (e48_q[46:31] != 16'd0);
-wire e_sat_lo = e48_q[47] && (e48_q[46:31] != 16'hffff);
-wire [31:0] e_sat = e_sat_hi ? 32'h7fff_ffff : (e_sat_lo ? 32'h8000_0000 : e48_q[31:0]);
-wire [47:0] e48_abs = e48_q[47] ? (~e48_q + 48'd1) : e48_q;       // |-2^47| = 2^47 fits
-wire fault_now = e48_abs > {{flim_q, 16'd0}};
-wire [31:0] e_abs = e_sat[31] ? (~e_sat + 32'd1) : e_sat;          // 2^31 fits
-wire [32:0] delta = primed ? ({{e_sat[31], e_sat}} - {{eprev_q[31], eprev_q}}) : 33'd0;
-wire [47:0] d_filt = $signed(f_q) >>> dfk_q;                       // F >>> k
-wire [47:0] f_next = f_q + {{{{15{{delta[32]}}}}, delta}} - d_filt; // F + Δ − (F >>> k)
-wire hold = (sat_hi && !e_sat[31] && (e_sat != 32'd0)) || (sat_lo && e_sat[31]);
-wire [48:0] i_sum = {{i_q[47], i_q}} + {{{{17{{e_sat[31]}}}}, e_sat}};
-wire [48:0] i_lim = {{1'b0, ilim_q}};
-wire [48:0] i_neg_lim = ~i_lim + 49'd1;
-wire i_over = !i_sum[48] && (i_sum > i_lim);
-wire i_under = i_sum[48] && ($signed(i_sum) < $signed(i_neg_lim));
-wire [47:0] i_next = hold ? i_q : (i_over ? i_lim[47:0] : (i_under ? i_neg_lim[47:0] : i_sum[47:0]));
-
-// The next term's operand (sign-extended to 64 bits) and gain: term 0 on step 0, else term + 1.
-wire [2:0] next_term = step0 ? 3'd0 : term + 3'd1;
-reg [63:0] op;
-reg [47:0] next_gain;
-always @(*) begin
-   case (next_term)
-   3'd0: begin op = {{{{32{{e_sat[31]}}}}, e_sat}}; next_gain = kp_q; end
-   3'd1: begin op = {{{{16{{i_q[47]}}}}, i_q}}; next_gain = ki_q; end
-   3'd2: begin op = {{{{16{{d_filt[47]}}}}, d_filt}}; next_gain = kd_q; end   // F updated on step 0
-   3'd3: begin op = {{{{8{{vs_q[55]}}}}, vs_q}}; next_gain = kv_q; end
-   default: begin op = as_q; next_gain = ka_q; end
-   endcase
-end
-wire [63:0] op_mag = op[63] ? (~op + 64'd1) : op;                   // |-2^63| = 2^63 fits
-
-// One gain digit (most significant first) times the magnitude: four 16 x 16 products,
-// registered; added to the accumulator on the next clock.
-wire [15:0] g = (digit == 3'd0) ? gain_q[47:32] : ((digit == 3'd1) ? gain_q[31:16] : gain_q[15:0]);
-wire [79:0] partial = {{16'd0, p2, p0}} + {{p3, p1, 16'd0}};
-wire [111:0] acc_next = {{acc_q[95:0], 16'd0}} + {{32'd0, partial}};
-
-// Finish: round to nearest (halves up): (sum + 2^47) >>> 48 = sum[115:48] + sum[47]; saturate.
-wire [67:0] u = sum_q[115:48] + {{67'd0, sum_q[47]}};
-wire [67:0] lim = {{52'd0, olim_q}};
-wire [67:0] neg_lim = ~lim + 68'd1;
-wire u_hi = $signed(u) > $signed(lim);
-wire u_lo = $signed(u) < $signed(neg_lim);
-
-always @(posedge clock) begin
-   fault_q <= 1'b0;
-   overrun_q <= 1'b0;
-   if (reset || start) peak_q <= 32'd0;
-   if (reset || !enable) begin
-      divider <= 16'd0;
-      busy <= 1'b0;
-      step0 <= 1'b0;
-      term <= 3'd0;
-      digit <= 3'd0;
-      fin <= 1'b0;
-      p0 <= 32'd0;
-      p1 <= 32'd0;
-      p2 <= 32'd0;
-      p3 <= 32'd0;
-      e48_q <= 48'd0;
-      vs_q <= 56'd0;
-      as_q <= 64'd0;
-      f_q <= 48'd0;
-      i_q <= 48'd0;
-      eprev_q <= 32'd0;
-      primed <= 1'b0;
-      sat_hi <= 1'b0;
-      sat_lo <= 1'b0;
-      mag_q <= 64'd0;
-      neg_q <= 1'b0;
-      gain_q <= 48'd0;
-      acc_q <= 112'd0;
-      sum_q <= 116'd0;
-      duty_q <= 16'd0;
-   end else begin
-      if (tick && (period != 16'd0)) divider <= (divider == 16'd0) ? period - 16'd1 : divider - 16'd1;
-      if (due && busy) overrun_q <= 1'b1;
-      else if (due) begin
-         e48_q <= e48_now;
-         vs_q <= velocity;
-         as_q <= accel;
-         kp_q <= kp;
-         ki_q <= ki;
-         kd_q <= kd;
-         kv_q <= kv;
-         ka_q <= ka;
-         ilim_q <= integral_limit;
-         olim_q <= output_limit;
-         flim_q <= following_limit;
-         dfk_q <= d_filter;
-         busy <= 1'b1;
-         step0 <= 1'b1;
-      end
-      if (busy) begin
-         if (step0) begin
-            fault_q <= fault_now;
-            if (!start && (e_abs > peak_q)) peak_q <= e_abs;
-            f_q <= f_next;
-            i_q <= i_next;
-            eprev_q <= e_sat;
-            primed <= 1'b1;
-            sum_q <= 116'd0;
-            acc_q <= 112'd0;
-            mag_q <= op_mag;
-            neg_q <= op[63];
-            gain_q <= next_gain;
-            step0 <= 1'b0;
-            term <= 3'd0;
-            digit <= 3'd0;
-         end else if (!fin) begin
-            if (digit != 3'd{sum_clock}) begin
-               if (digit != 3'd0) acc_q <= acc_next;
-               if (digit < 3'd{digits}) begin
-                  p0 <= g * mag_q[15:0];
-                  p1 <= g * mag_q[31:16];
-                  p2 <= g * mag_q[47:32];
-                  p3 <= g * mag_q[63:48];
-               end
-               digit <= digit + 3'd1;
-            end else begin
-               sum_q <= neg_q ? sum_q - {{4'd0, acc_q}} : sum_q + {{4'd0, acc_q}};
-               acc_q <= 112'd0;
-               digit <= 3'd0;
-               if (term != 3'd{last_term}) begin
-                  mag_q <= op_mag;
-                  neg_q <= op[63];
-                  gain_q <= next_gain;
-                  term <= term + 3'd1;
-               end else fin <= 1'b1;
-            end
-         end else begin
-            sat_hi <= u_hi;
-            sat_lo <= u_lo;
-            duty_q <= u_hi ? olim_q : (u_lo ? neg_lim[15:0] : u[15:0]);
-            busy <= 1'b0;
-            fin <= 1'b0;
-         end
-      end
-   end
-end
-
-always @(*) begin
-   duty = duty_q;
-   fault = fault_q;
-   overrun = overrun_q;
-   peak = peak_q;
-end
-"#,
-        e_frac = E_FRAC,
-        v_shift = V_SHIFT,
-        a_shift = A_SHIFT,
-        half = OUT_SHIFT - 1,
-        out_shift = OUT_SHIFT,
-        latency = LATENCY,
-        last_digit = DIGITS - 1,
-        digits = DIGITS,
-        sum_clock = DIGITS + 1,
-        last_term = TERMS - 1,
-    )
+    let holes = Holes::new()
+        .value("E_FRAC", E_FRAC)
+        .value("V_SHIFT", V_SHIFT)
+        .value("A_SHIFT", A_SHIFT)
+        .value("HALF", OUT_SHIFT - 1)
+        .value("OUT_SHIFT", OUT_SHIFT)
+        .value("LATENCY", LATENCY)
+        .value("LAST_DIGIT", DIGITS - 1)
+        .value("DIGITS", DIGITS)
+        .value("SUM_CLOCK", DIGITS + 1)
+        .value("LAST_TERM", TERMS - 1);
+    let body = fill("servo.v", TEMPLATE, &holes).expect("the controller's template is filled");
+    crate::protocol_v::with_localparams(&crate::protocol_v::localparams(), &body)
 }
 
 #[cfg(test)]

@@ -87,7 +87,7 @@ fn stimulus() -> Vec<(CoreInputs, usize)> {
             s.push((base, 9));
             s.push((
                 CoreInputs {
-                    abort: true,
+                    abort_move: true,
                     ..base
                 },
                 1,
@@ -111,7 +111,7 @@ fn rust_hdl_core_matches_the_model_clock_by_clock() {
             x.reset.next = i.reset;
             x.tick_div.next = u64::from(i.tick_div).into();
             x.start.next = i.start;
-            x.abort_move.next = i.abort;
+            x.abort_move.next = i.abort_move;
             x.write_enable.next = i.write_enable;
             x.write_address.next = u64::from(i.write_address).into();
             x.write_ticks.next = u64::from(i.write_ticks).into();

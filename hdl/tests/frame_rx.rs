@@ -5,7 +5,7 @@
 
 use rust_hdl::prelude::*;
 use snapgen_hdl::frame_rx::FrameRx;
-use snapgen_model::protocol::{Command, Decoded, Decoder, Param};
+use snapgen_host::protocol::{Command, Decoded, Decoder, Param};
 use snapgen_model::{Segment, DEFAULT_FORMAT};
 
 mod common;

@@ -68,6 +68,11 @@ fn every_block_lints_clean() {
         &[],
     );
     lint(
+        "flags_word",
+        snapgen_hdl::status_block::FlagsWord::default(),
+        &[],
+    );
+    lint(
         "input_filter",
         snapgen_hdl::input_filter::InputFilter::new(false),
         &[],

@@ -45,7 +45,7 @@ fn config(r: &mut Rng) -> ServoConfig {
         }
     };
     ServoConfig {
-        period: [1, 1, 2, 3][r.below(4) as usize],
+        servo_period: [1, 1, 2, 3][r.below(4) as usize],
         kp: g(r),
         ki: g(r),
         kd: g(r),
@@ -121,7 +121,7 @@ fn run(clocks: usize, inject: Option<usize>) -> Result<(), SimError> {
             s.velocity.next = bits(i.v >> 48);
             s.accel.next = bits(i.a >> 40);
             s.count.next = bits(i128::from(i.count));
-            s.period.next = bits(i128::from(c.period));
+            s.servo_period.next = bits(i128::from(c.servo_period));
             s.kp.next = bits(i128::from(c.kp));
             s.ki.next = bits(i128::from(c.ki));
             s.kd.next = bits(i128::from(c.kd));

@@ -22,14 +22,14 @@
 //!   `decide` clocks before every tick choosing that tick's snap (ticks wait for it); when the
 //!   registers are at rest it lets go (`stopping` falls). Requests while a stop runs are
 //!   ignored.
-//! * `abort` zeroes v, a and j at once (the emergency stop, with the amplifier off) and
+//! * `abort_move` zeroes v, a and j at once (the emergency stop, with the amplifier off) and
 //!   cancels a stop; reset puts x at the centre of cell 0; `load` puts it at the centre of
 //!   cell `load_position` with v = a = j = 0 (the executor raises it only with the axis at
 //!   rest and no program playing).
 //! * `tick_count` counts the ticks since the last start while a program plays or a stop runs;
 //!   `ticks` counts every tick since reset (64 bits).
-//! * `at_rest` is v = a = j = 0; `heading` (registered) is the sign of the first non-zero of
-//!   v, a, j: where the axis goes next (a move from rest heads somewhere from its first tick).
+//! * `at_rest` is v = a = j = 0; `heading_pos`/`heading_neg` (registered) give the sign of the
+//!   first non-zero of v, a, j: where the axis goes next (a move from rest heads somewhere from its first tick).
 //! * Writes go to the standby bank.
 //! * `swap` arms a **program swap** for the tick T = `swap_last + 1` (low 32 bits of the time
 //!   base): the tick that brings `ticks` from `swap_last` to T is still the old program's (or
@@ -46,90 +46,11 @@ use crate::format::{Format, Widths, FRAC_BITS};
 use crate::stop::{phase_clocks, PhaseClocks, StopLaw, StopLimits};
 
 /// Segments per bank.
-pub const BANK_DEPTH: usize = 32;
+pub const BANK_DEPTH: usize = snapgen_spec::widths::MAX_SEGMENTS as usize;
+/// A segment index or count (`INDEX_BITS` wide) wraps with this mask.
+const INDEX_MASK: u8 = ((1u32 << snapgen_spec::widths::INDEX_BITS) - 1) as u8;
 
-/// The core's inputs for one clock.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CoreInputs {
-    /// Synchronous reset.
-    pub reset: bool,
-    /// Clocks per tick minus one.
-    pub tick_div: u32,
-    /// Start the standby program.
-    pub start: bool,
-    /// Abort now: v = a = j = 0 (the emergency stop).
-    pub abort: bool,
-    /// Controlled stop, taken on the next tick.
-    pub stop: bool,
-    /// The reference takes the encoder's position: x at the centre of output cell
-    /// `load_position`, v = a = j = 0 (POWER 1 from Disabled, when the axis is at rest).
-    pub load: bool,
-    /// The encoder count for `load` (32 bits).
-    pub load_position: u32,
-    /// The stop's limits (latched when a stop is taken).
-    pub stop_limits: StopLimits,
-    /// Write one segment of the standby program.
-    pub write_enable: bool,
-    /// Segment address to write (0..32).
-    pub write_address: u8,
-    /// Tick count to write.
-    pub write_ticks: u32,
-    /// Snap to write (raw; the low `d` bits are stored).
-    pub write_snap: i128,
-    /// Set the standby program's segment count.
-    pub count_enable: bool,
-    /// Segment count (0..=32).
-    pub count_value: u8,
-    /// Arm a program swap for the tick after `swap_last`.
-    pub swap: bool,
-    /// The low 32 bits of the time base on the old program's last tick (T − 1, where the
-    /// state at T is the new program's start).
-    pub swap_last: u32,
-}
-
-/// The core's outputs after a clock edge.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CoreOutputs {
-    /// Position register.
-    pub x: i128,
-    /// Velocity register.
-    pub v: i128,
-    /// Acceleration register.
-    pub a: i128,
-    /// Jerk register.
-    pub j: i128,
-    /// Whole output LSBs: `x >> FRAC_BITS`, low 32 bits.
-    pub position: u32,
-    /// Segment playing.
-    pub segment: u8,
-    /// Playing a program.
-    pub busy: bool,
-    /// Last program ran to its end.
-    pub done: bool,
-    /// Last program was cut short (by a stop or an abort).
-    pub aborted: bool,
-    /// A controlled stop is requested or running.
-    pub stopping: bool,
-    /// The last stop began outside its limits (and landed regardless of them).
-    pub stop_over: bool,
-    /// Ticks since the last start (while playing or stopping).
-    pub tick_count: u32,
-    /// Ticks since reset.
-    pub ticks: u64,
-    /// Tick enable (combinational, for the next edge).
-    pub tick: bool,
-    /// The chain is at rest: v = a = j = 0 (combinational, from the registers).
-    pub at_rest: bool,
-    /// Where the axis is heading (−1, 0, +1), registered from the registers before the last
-    /// edge: the sign of v, or of a when v = 0, or of j when v = a = 0.
-    pub heading: i8,
-    /// Bank playing.
-    pub active_bank: bool,
-    /// Segment count of the standby program.
-    pub standby_count: u8,
-    /// A program swap is armed.
-    pub swap_pending: bool,
-}
+pub use crate::ports::{CoreCommand, CoreInputs, CoreOutputs, CoreStatus};
 
 /// Where the stop unit is.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -258,7 +179,7 @@ impl CoreModel {
             && tick
             && self.ticks as u32 == self.swap_last
             && !i.reset
-            && !i.abort
+            && !i.abort_move
             && !i.stop;
         let fetch_first = !self.busy || due;
         let read_bank = usize::from(self.bank ^ fetch_first);
@@ -270,7 +191,7 @@ impl CoreModel {
         };
         let entry_ticks = self.mem_ticks[read_bank][address];
         let entry_snap = self.mem_snap[read_bank][address];
-        let next_index = (self.index + 1) & 0x3f;
+        let next_index = (self.index + 1) & INDEX_MASK;
         let stopping = self.stop_phase != StopPhase::Idle;
         // The stop has been taken: its ticks count.
         let engaged = matches!(
@@ -279,13 +200,13 @@ impl CoreModel {
         );
         let old_busy = self.busy;
         let started =
-            !i.reset && !i.abort && i.start && !self.busy && !stopping && !self.swap_pending;
+            !i.reset && !i.abort_move && i.start && !self.busy && !stopping && !self.swap_pending;
         let chain_snap = match self.stop_phase {
             StopPhase::Ready(d) => d,
             _ => self.snap,
         };
         let old_bank = self.bank;
-        let engage = tick && self.stop_phase == StopPhase::Armed && !i.reset && !i.abort;
+        let engage = tick && self.stop_phase == StopPhase::Armed && !i.reset && !i.abort_move;
 
         // Sequencer.
         if i.reset {
@@ -296,7 +217,7 @@ impl CoreModel {
             self.snap = 0;
             self.tick_count = 0;
             self.ticks = 0;
-        } else if i.abort {
+        } else if i.abort_move {
             self.busy = false;
             self.snap = 0;
         } else if started {
@@ -357,7 +278,7 @@ impl CoreModel {
             .swap_last
             .wrapping_sub((self.ticks as u32).wrapping_add(1))
             .wrapping_sub(1);
-        if i.reset || i.abort || i.stop || due {
+        if i.reset || i.abort_move || i.stop || due {
             self.swap_pending = false;
         } else if i.swap && !self.swap_pending && !stopping && lead < 1 << 31 {
             self.swap_pending = true;
@@ -382,7 +303,7 @@ impl CoreModel {
         // Chain (eqs 72–75 on a tick, from the snap before the edge).
         if i.reset {
             self.chain = ChainState::at_rest(self.home);
-        } else if i.abort {
+        } else if i.abort_move {
             self.chain = ChainState::at_rest(self.chain.x);
         } else if i.load {
             let cell = i128::from(i.load_position as i32) << FRAC_BITS;
@@ -392,7 +313,7 @@ impl CoreModel {
         }
 
         // The stop unit.
-        if i.reset || i.abort {
+        if i.reset || i.abort_move {
             self.stop_phase = StopPhase::Idle;
             self.stop_law = None;
             if i.reset {
@@ -405,8 +326,8 @@ impl CoreModel {
                     // The fabric's limit inputs are 104-bit unsigned.
                     let mask = (1i128 << w.d) - 1;
                     self.stop_limits = StopLimits {
-                        jerk: i.stop_limits.jerk & mask,
-                        accel: i.stop_limits.accel & mask,
+                        jerk: i.stop_jerk & mask,
+                        accel: i.stop_accel & mask,
                     };
                     StopPhase::Prep(c.prep)
                 }
@@ -457,9 +378,9 @@ impl CoreModel {
             self.aborted = false;
             self.counts[usize::from(old_bank)] = 0;
         } else if i.count_enable {
-            self.counts[usize::from(!old_bank)] = i.count_value & 0x3f;
+            self.counts[usize::from(!old_bank)] = i.count_value & INDEX_MASK;
         }
-        if !i.reset && (i.abort || engage) && old_busy {
+        if !i.reset && (i.abort_move || engage) && old_busy {
             self.aborted = true;
         }
 
@@ -499,7 +420,8 @@ impl CoreModel {
             ticks: self.ticks,
             tick: self.tick_now(self.tick_div),
             at_rest: self.chain.v == 0 && self.chain.a == 0 && self.chain.j == 0,
-            heading: self.heading,
+            heading_pos: self.heading > 0,
+            heading_neg: self.heading < 0,
             active_bank: self.bank,
             standby_count: self.counts[usize::from(!self.bank)],
             swap_pending: self.swap_pending,
@@ -583,27 +505,25 @@ mod tests {
     /// registers at the tick the stop was taken) and ends at rest.
     #[test]
     fn a_controlled_stop_follows_the_law_to_rest() {
-        use crate::planner::{plan, Method, MoveRequest};
-        let f = DEFAULT_FORMAT;
         let c = phase_clocks();
-        let p = plan(
-            &MoveRequest {
-                distance: 0.5,
-                method: Method::Order3 {
-                    vmax: 1.0,
-                    amax: 5.0,
-                    jmax: 50.0,
+        // An order-3 start: a jerk step to `d`, held for 20 000 ticks (the stop comes in it).
+        let d = 1i128 << 40;
+        let program = Program {
+            segments: vec![
+                Segment { ticks: 1, snap: d },
+                Segment {
+                    ticks: 20_000,
+                    snap: 0,
                 },
-            },
-            &f,
-        )
-        .unwrap();
+                Segment { ticks: 1, snap: -d },
+            ],
+        };
         let limits = StopLimits {
-            jerk: 2 * p.amplitude_raw.abs(),
+            jerk: 2 * d,
             accel: 1 << 90,
         };
         let mut m = reset();
-        load(&mut m, &p.program);
+        load(&mut m, &program);
         m.clock(&CoreInputs {
             start: true,
             ..Default::default()
@@ -614,7 +534,8 @@ mod tests {
         }
         let o = m.clock(&CoreInputs {
             stop: true,
-            stop_limits: limits,
+            stop_jerk: limits.jerk,
+            stop_accel: limits.accel,
             ..Default::default()
         });
         assert!(
@@ -712,12 +633,13 @@ mod tests {
         }
         m.clock(&CoreInputs {
             stop: true,
-            stop_limits: StopLimits { jerk: 1, accel: 10 },
+            stop_jerk: 1,
+            stop_accel: 10,
             ..Default::default()
         });
         let x = m.chain().x;
         let o = m.clock(&CoreInputs {
-            abort: true,
+            abort_move: true,
             ..Default::default()
         });
         assert!(!o.busy && !o.stopping && o.aborted);
@@ -868,10 +790,8 @@ mod tests {
         });
         let o = m.clock(&CoreInputs {
             stop: true,
-            stop_limits: StopLimits {
-                jerk: 100,
-                accel: 1000,
-            },
+            stop_jerk: 100,
+            stop_accel: 1000,
             ..Default::default()
         });
         assert!(!o.swap_pending && o.stopping);

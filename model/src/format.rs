@@ -24,8 +24,11 @@ use crate::error::FormatError;
 
 /// Number of fractional bits of the position register below the output LSB.
 ///
-/// Fixed at compile time so that the typed position, [`PositionFix`], can state its layout.
-pub const FRAC_BITS: u32 = 80;
+/// Fixed at compile time so that the typed position, [`PositionFix`], can state its layout
+/// (the fabric's, `snapgen_spec::widths::FRAC_BITS`).
+pub const FRAC_BITS: u32 = snapgen_spec::widths::FRAC_BITS;
+
+const _: () = assert!(FRAC_BITS == 80, "PositionFix's layout (U80) states it");
 
 /// A position in output LSBs with [`FRAC_BITS`] fractional bits: the typed view of the raw
 /// position register (`to_bits`/`from_bits` give the register's integer).
@@ -47,6 +50,15 @@ pub struct Widths {
 }
 
 impl Widths {
+    /// The fabric's widths (`snapgen_spec::widths`).
+    pub const FABRIC: Widths = Widths {
+        x: snapgen_spec::widths::X_BITS,
+        v: snapgen_spec::widths::V_BITS,
+        a: snapgen_spec::widths::A_BITS,
+        j: snapgen_spec::widths::J_BITS,
+        d: snapgen_spec::widths::D_BITS,
+    };
+
     /// The widths in chain order `[x, v, a, j, d]`.
     pub fn as_array(&self) -> [u32; 5] {
         [self.x, self.v, self.a, self.j, self.d]
@@ -68,21 +80,16 @@ pub struct Format {
     pub max_segments: usize,
 }
 
-/// The default format: `Ts` = 10 µs (125 MHz / 1250), output LSB = 1e-6 unit, 80 fractional bits,
-/// position 112 bits, velocity/acceleration/jerk/snap 104 bits, 32-bit segment tick counts,
-/// 32 segments per program.
+/// The default format: `Ts` = 10 µs (125 MHz / 1250), output LSB = 1e-6 unit, and the
+/// fabric's widths (`snapgen_spec::widths`: 80 fractional bits, position 112 bits,
+/// velocity/acceleration/jerk/snap 104 bits, 32-bit segment tick counts, 32 segments per
+/// program).
 pub const DEFAULT_FORMAT: Format = Format {
     ts: 1e-5,
     position_lsb: 1e-6,
-    widths: Widths {
-        x: 112,
-        v: 104,
-        a: 104,
-        j: 104,
-        d: 104,
-    },
-    tick_bits: 32,
-    max_segments: 32,
+    widths: Widths::FABRIC,
+    tick_bits: snapgen_spec::widths::TICK_BITS,
+    max_segments: snapgen_spec::widths::MAX_SEGMENTS as usize,
 };
 
 impl Default for Format {
@@ -208,6 +215,18 @@ impl Format {
             }
         }
         Ok(())
+    }
+
+    /// True when a board that says `id` about itself has this format's widths, fractional
+    /// bits, tick bits, program depth and snap bytes (its `Ts` is the host's to take).
+    pub fn matches_identity(&self, id: &snapgen_spec::Identity) -> bool {
+        let w = self.widths.as_array();
+        let got = [id.x_bits, id.v_bits, id.a_bits, id.j_bits, id.d_bits];
+        got.iter().zip(w).all(|(&a, b)| u32::from(a) == b)
+            && u32::from(id.frac_bits) == FRAC_BITS
+            && u32::from(id.tick_bits) == self.tick_bits
+            && usize::from(id.max_segments) == self.max_segments
+            && usize::from(id.snap_bytes) == self.widths.d.div_ceil(8) as usize
     }
 
     /// The internal LSB `L` of the position register, in user units.

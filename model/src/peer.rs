@@ -136,9 +136,9 @@ impl Peer {
             enc_b: b,
             enc_i: self.index_period != 0
                 && self.encoder.rem_euclid(i64::from(self.index_period)) == 0,
-            limit_positive: self.limit_positive ^ (self.wiring & 1 != 0),
-            limit_negative: self.limit_negative ^ (self.wiring & 2 != 0),
-            emergency_stop: self.emergency_stop ^ (self.wiring & 4 != 0),
+            limit_pos: self.limit_positive ^ (self.wiring & 1 != 0),
+            limit_neg: self.limit_negative ^ (self.wiring & 2 != 0),
+            estop: self.emergency_stop ^ (self.wiring & 4 != 0),
         }
     }
 

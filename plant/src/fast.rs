@@ -181,7 +181,7 @@ impl FastLoop {
 
     fn tick(&mut self, sink: &mut impl FnMut(&LoopSample)) {
         // The sample, from the registers before this tick.
-        if self.cfg.period != 0 {
+        if self.cfg.servo_period != 0 {
             if self.divider == 0 {
                 let count = self.plant.count();
                 let s = self
@@ -201,7 +201,7 @@ impl FastLoop {
                     duty: s.duty,
                     volts: self.plant.volts(),
                 });
-                self.divider = self.cfg.period - 1;
+                self.divider = self.cfg.servo_period - 1;
             } else {
                 self.divider -= 1;
             }

@@ -226,7 +226,7 @@ pub fn derive(
         .round()
         .clamp(0.0, 15.0);
     let config = ServoConfig {
-        period: timing.servo_period,
+        servo_period: timing.servo_period,
         d_filter: if design.d_filter_ratio > 0.0 {
             shift as u8
         } else {

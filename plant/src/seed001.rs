@@ -6,7 +6,8 @@
 use std::f64::consts::PI;
 
 use serde::Serialize;
-use snapgen_model::{plan_from, ChainState, Format, Method, MoveRequest, Plan, PlanError};
+use snapgen_model::{ChainState, Format};
+use snapgen_plan::{plan_from, Method, MoveRequest, Plan, PlanError};
 
 use crate::metrics::MoveSpan;
 

@@ -19,9 +19,8 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use snapgen_model::device::Design;
 use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
-use snapgen_model::{
-    plan_from, ChainState, Format, Method, MoveRequest, Plan, Quantity, DEFAULT_FORMAT,
-};
+use snapgen_model::{ChainState, Format, Quantity, DEFAULT_FORMAT};
+use snapgen_plan::{plan_from, Method, MoveRequest, Plan};
 use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
 use snapgen_plant::PlantParams;

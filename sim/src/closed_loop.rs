@@ -12,10 +12,10 @@
 //! and the motor is integrated. Without the fabric (`fabric: false`) the model drives the
 //! motor: the same loop, model only.
 
+use snapgen_host::protocol::{Command, Decoded, Decoder, Param, Reason, Reply};
 use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
 use snapgen_model::io::servo::ServoConfig;
 use snapgen_model::peer::Peer;
-use snapgen_model::protocol::{Command, Decoded, Decoder, Param, Reason, Reply};
 use snapgen_model::stop::StopLimits;
 use snapgen_model::{Program, FRAC_BITS};
 use snapgen_plant::fast::LoopSample;
@@ -347,7 +347,7 @@ impl ClosedLoop {
             (Param::StopJerk, s.stop.jerk),
             (Param::StopAccel, s.stop.accel),
         ];
-        let servo = snapgen_model::io::executor::Config::servo_writes(&s.servo);
+        let servo = s.servo.writes();
         for &(param, value) in head.iter().chain(&servo).chain(&stop) {
             self.command(Command::Configure { param, value })?;
         }

@@ -18,15 +18,14 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use snapgen_model::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
-use snapgen_model::{
-    plan_from, ChainState, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT,
-};
+use snapgen_model::{ChainState, CoreInputs, CoreModel, CoreOutputs, Format, DEFAULT_FORMAT};
+use snapgen_plan::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
+use snapgen_plan::plan_from;
 
 mod streams;
 
 use crate::build::build;
-use crate::fabric::{Fabric, VcdWindow, CORE_OUTPUTS, OUT_SLOTS, OUT_WORDS};
+use crate::fabric::{Fabric, VcdWindow, CORE_OUTPUTS, OUTPUT_BITS, OUT_SLOTS, OUT_WORDS};
 use crate::moves::{log_uniform, MoveSpec, MoveStream, OrderMix};
 use crate::SimError;
 
@@ -45,122 +44,49 @@ const MAX_MOVE_TICKS: u64 = 400_000;
 /// tick waits for the stop unit's decision, so a long stop costs many clocks).
 const MAX_STOP_CLOCKS: u64 = 600_000;
 
-/// A compared output (in the order of [`CORE_OUTPUTS`], which gives its name and width).
+/// A compared output: an index into [`CORE_OUTPUTS`] (the spec's port list), which gives its
+/// name and width.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Register {
-    /// Position register.
-    X,
-    /// Velocity register.
-    V,
-    /// Acceleration register.
-    A,
-    /// Jerk register.
-    J,
-    /// Whole-LSB position output.
-    Position,
-    /// Segment index.
-    Segment,
-    /// Busy flag.
-    Busy,
-    /// Done flag.
-    Done,
-    /// Aborted flag.
-    Aborted,
-    /// A controlled stop is requested or runs.
-    Stopping,
-    /// The last stop began outside its limits.
-    StopOver,
-    /// Tick enable.
-    Tick,
-    /// Heading forward.
-    HeadingPos,
-    /// Heading backward.
-    HeadingNeg,
-    /// At rest (v = a = j = 0).
-    AtRest,
-    /// Active bank.
-    ActiveBank,
-    /// Standby program's segment count.
-    StandbyCount,
-    /// Tick counter.
-    TickCount,
-    /// Ticks since reset.
-    Ticks,
-    /// A program swap is armed.
-    SwapPending,
-}
+pub struct Register(usize);
 
 impl Register {
     /// Every register, in comparison order.
-    pub const ALL: [Register; 20] = [
-        Register::X,
-        Register::V,
-        Register::A,
-        Register::J,
-        Register::Position,
-        Register::Segment,
-        Register::Busy,
-        Register::Done,
-        Register::Aborted,
-        Register::Stopping,
-        Register::StopOver,
-        Register::Tick,
-        Register::HeadingPos,
-        Register::HeadingNeg,
-        Register::AtRest,
-        Register::ActiveBank,
-        Register::StandbyCount,
-        Register::TickCount,
-        Register::Ticks,
-        Register::SwapPending,
-    ];
+    pub fn all() -> impl Iterator<Item = Register> {
+        (0..CORE_OUTPUTS.len()).map(Register)
+    }
+
+    /// The register called `name` (its Verilog port).
+    pub fn named(name: &str) -> Option<Register> {
+        CORE_OUTPUTS
+            .iter()
+            .position(|p| p.name == name)
+            .map(Register)
+    }
 
     /// Its name (as the Verilog port).
     pub fn name(self) -> &'static str {
-        CORE_OUTPUTS[self as usize].name
+        CORE_OUTPUTS[self.0].name
     }
 
     /// Its width in bits.
     pub fn bits(self) -> u32 {
-        CORE_OUTPUTS[self as usize].bits
+        CORE_OUTPUTS[self.0].bits
     }
 
     /// Its raw bits in `o`, as an unsigned pattern of its width.
     #[inline(always)]
-    pub fn bits_of(self, o: &CoreOutputs, f: &Format) -> u128 {
-        let mask = |v: i128, b: u32| (v as u128) & (u128::MAX >> (128 - b));
-        match self {
-            Register::X => mask(o.x, f.widths.x),
-            Register::V => mask(o.v, f.widths.v),
-            Register::A => mask(o.a, f.widths.a),
-            Register::J => mask(o.j, f.widths.j),
-            Register::Position => u128::from(o.position),
-            Register::Segment => u128::from(o.segment),
-            Register::Busy => u128::from(o.busy),
-            Register::Done => u128::from(o.done),
-            Register::Aborted => u128::from(o.aborted),
-            Register::Stopping => u128::from(o.stopping),
-            Register::StopOver => u128::from(o.stop_over),
-            Register::Tick => u128::from(o.tick),
-            Register::HeadingPos => u128::from(o.heading > 0),
-            Register::HeadingNeg => u128::from(o.heading < 0),
-            Register::AtRest => u128::from(o.at_rest),
-            Register::ActiveBank => u128::from(o.active_bank),
-            Register::StandbyCount => u128::from(o.standby_count),
-            Register::TickCount => u128::from(o.tick_count),
-            Register::Ticks => u128::from(o.ticks),
-            Register::SwapPending => u128::from(o.swap_pending),
-        }
+    pub fn bits_of(self, o: &CoreOutputs) -> u128 {
+        OUTPUT_BITS[self.0](o) & (u128::MAX >> (128 - self.bits()))
     }
 
     /// Its bits in a clock's output words.
     pub fn bits_in(self, words: &[u32]) -> u128 {
-        OUT_SLOTS[self as usize].get(words)
+        OUT_SLOTS[self.0].get(words)
     }
 
     /// Flips bit `bit` (modulo its width) of this register in a clock's output words.
     pub fn flip(self, words: &mut [u32], bit: u32) {
-        let slot = OUT_SLOTS[self as usize];
+        let slot = OUT_SLOTS[self.0];
         let v = slot.get(words) ^ (1u128 << (bit % self.bits()));
         slot.put(words, v);
     }
@@ -169,10 +95,10 @@ impl Register {
 impl std::str::FromStr for Register {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Register::ALL
-            .into_iter()
-            .find(|r| r.name() == s)
-            .ok_or_else(|| format!("unknown register {s:?}"))
+        Register::named(s).ok_or_else(|| {
+            let names: Vec<&str> = CORE_OUTPUTS.iter().map(|p| p.name).collect();
+            format!("unknown register {s:?} (one of {})", names.join(", "))
+        })
     }
 }
 
@@ -435,7 +361,6 @@ impl ModelSide {
 struct Lockstep {
     fabric: Option<Fabric>,
     side: ModelSide,
-    format: Format,
     clock: u64,
     ticks: u64,
     buf: Vec<u32>,
@@ -447,7 +372,6 @@ struct Lockstep {
 impl Lockstep {
     /// `n` clocks with inputs `i` on both sides, compared.
     fn drive(&mut self, i: &CoreInputs, n: u64) -> Result<(), Mismatch> {
-        let f = self.format;
         if let Some(fab) = self.fabric.as_mut() {
             fab.set(i);
         }
@@ -463,23 +387,22 @@ impl Lockstep {
                         let (m, ticked) = self.side.clock(i);
                         let faulty = self.fault.is_some_and(|fl| fl.clock == self.clock);
                         // A word differs (or the fault is due): compare register by register.
-                        if faulty || differs(&m, words, &f) {
+                        if faulty || differs(&m, words) {
                             let mut words = *words;
                             if let Some(fl) = self.fault.filter(|_| faulty) {
                                 fl.register.flip(&mut words, fl.bit);
                             }
                             // Every bit of every word belongs to a register (tested), so a
                             // difference is always found here.
-                            if let Some(register) = Register::ALL
-                                .into_iter()
-                                .find(|r| r.bits_of(&m, &f) != r.bits_in(&words))
+                            if let Some(register) =
+                                Register::all().find(|r| r.bits_of(&m) != r.bits_in(&words))
                             {
                                 return Err(Mismatch {
                                     session: self.session,
                                     clock: self.clock,
                                     move_index: self.move_index,
                                     register,
-                                    expected: register.bits_of(&m, &f),
+                                    expected: register.bits_of(&m),
                                     actual: register.bits_in(&words),
                                     bits: register.bits(),
                                 });
@@ -513,8 +436,8 @@ impl Lockstep {
 /// encoded in the same layout ([`crate::fabric::encode`]) and compared word for word (the
 /// differences ORed together, without a branch or a call per word).
 #[inline(always)]
-fn differs(m: &CoreOutputs, w: &[u32; OUT_WORDS], f: &Format) -> bool {
-    let e = crate::fabric::encode(m, f);
+fn differs(m: &CoreOutputs, w: &[u32; OUT_WORDS]) -> bool {
+    let e = crate::fabric::encode(m);
     e.iter().zip(w).fold(0u32, |acc, (x, y)| acc | (x ^ y)) != 0
 }
 
@@ -529,7 +452,6 @@ fn session(
     let mut ls = Lockstep {
         fabric,
         side: ModelSide::new(&format),
-        format,
         clock: 0,
         ticks: 0,
         buf: Vec::new(),
@@ -643,7 +565,7 @@ fn session(
                 ls.drive(&idle, after.min(budget))?;
                 ls.drive(
                     &CoreInputs {
-                        abort: true,
+                        abort_move: true,
                         ..idle
                     },
                     1,
@@ -707,7 +629,8 @@ fn controlled_stop(
 ) -> Result<(), Mismatch> {
     let stop = CoreInputs {
         stop: true,
-        stop_limits: spec.stop_limits,
+        stop_jerk: spec.stop_limits.jerk,
+        stop_accel: spec.stop_limits.accel,
         ..*idle
     };
     ls.drive(&stop, 1)?;
@@ -731,7 +654,7 @@ fn controlled_stop(
         } else {
             ls.drive(
                 &CoreInputs {
-                    abort: true,
+                    abort_move: true,
                     ..*idle
                 },
                 1,
@@ -1153,62 +1076,30 @@ mod tests {
     use super::*;
     use crate::fabric::{decode, encode};
 
-    /// Outputs with every field drawn from `seed` (registers wrapped to their widths).
-    fn outputs(seed: u64, f: &Format) -> CoreOutputs {
+    /// Outputs with every port's bits drawn from `seed` (random words, decoded).
+    fn outputs(seed: u64) -> CoreOutputs {
         use rand::{Rng, SeedableRng};
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let mut wide = |bits| snapgen_model::chain::wrap(rng.gen::<i128>(), bits);
-        let (x, v, a, j) = (
-            wide(f.widths.x),
-            wide(f.widths.v),
-            wide(f.widths.a),
-            wide(f.widths.j),
-        );
-        CoreOutputs {
-            x,
-            v,
-            a,
-            j,
-            position: rng.gen(),
-            segment: rng.gen_range(0..64),
-            busy: rng.gen(),
-            done: rng.gen(),
-            aborted: rng.gen(),
-            stopping: rng.gen(),
-            stop_over: rng.gen(),
-            tick_count: rng.gen(),
-            ticks: rng.gen(),
-            tick: rng.gen(),
-            heading: rng.gen_range(-1..=1),
-            at_rest: rng.gen(),
-            active_bank: rng.gen(),
-            standby_count: rng.gen_range(0..64),
-            swap_pending: rng.gen(),
-        }
+        let words: Vec<u32> = (0..OUT_WORDS).map(|_| rng.gen()).collect();
+        decode(&words)
     }
 
     /// Every bit of every output word belongs to a register: a flip anywhere is seen by the
     /// comparison and found in a register.
     #[test]
     fn the_comparison_sees_every_bit_of_every_word() {
-        let f = DEFAULT_FORMAT;
         for seed in 0..64 {
-            let m = outputs(seed, &f);
-            let words = encode(&m, &f);
-            assert_eq!(decode(&words, &f), m, "layout round trip, seed {seed}");
-            assert!(!differs(&m, &words, &f), "equal outputs, seed {seed}");
+            let m = outputs(seed);
+            let words = encode(&m);
+            assert_eq!(decode(&words), m, "layout round trip, seed {seed}");
+            assert!(!differs(&m, &words), "equal outputs, seed {seed}");
             for k in 0..OUT_WORDS {
                 for bit in 0..32 {
                     let mut bad = words;
                     bad[k] ^= 1 << bit;
-                    let found = Register::ALL
-                        .into_iter()
-                        .any(|r| r.bits_of(&m, &f) != r.bits_in(&bad));
+                    let found = Register::all().any(|r| r.bits_of(&m) != r.bits_in(&bad));
                     let used = OUT_SLOTS.iter().any(|s| s.covers(k, bit));
-                    assert!(
-                        differs(&m, &bad, &f),
-                        "word {k} bit {bit} unseen, seed {seed}"
-                    );
+                    assert!(differs(&m, &bad), "word {k} bit {bit} unseen, seed {seed}");
                     assert_eq!(found, used, "word {k} bit {bit}, seed {seed}");
                 }
             }

@@ -4,177 +4,71 @@ use std::ffi::{c_char, c_void, CString};
 use std::path::{Path, PathBuf};
 
 use libloading::Library;
-use snapgen_hdl::{
-    ADDR_BITS, A_BITS, D_BITS, INDEX_BITS, J_BITS, POSITION_BITS, TICK_BITS, V_BITS, X_BITS,
-};
-use snapgen_model::chain::wrap;
-use snapgen_model::{CoreInputs, CoreOutputs, Format};
+use snapgen_model::{CoreInputs, CoreOutputs};
 
-use crate::layout::{harness_header, pack, Port, Slot};
+use crate::layout::{harness_header, pack, Port, PortValue, Slot};
 use crate::SimError;
 
-/// The core's inputs, in the harness's word order (the wrapper registers each of them).
-pub const CORE_INPUTS: [Port; 17] = [
-    Port {
-        name: "reset",
-        bits: 1,
-    },
-    Port {
-        name: "tick_div",
-        bits: TICK_BITS as u32,
-    },
-    Port {
-        name: "start",
-        bits: 1,
-    },
-    Port {
-        name: "abort_move",
-        bits: 1,
-    },
-    Port {
-        name: "stop",
-        bits: 1,
-    },
-    Port {
-        name: "load",
-        bits: 1,
-    },
-    Port {
-        name: "load_position",
-        bits: POSITION_BITS as u32,
-    },
-    Port {
-        name: "stop_jerk",
-        bits: D_BITS as u32,
-    },
-    Port {
-        name: "stop_accel",
-        bits: D_BITS as u32,
-    },
-    Port {
-        name: "write_enable",
-        bits: 1,
-    },
-    Port {
-        name: "write_address",
-        bits: ADDR_BITS as u32,
-    },
-    Port {
-        name: "write_ticks",
-        bits: TICK_BITS as u32,
-    },
-    Port {
-        name: "write_snap",
-        bits: D_BITS as u32,
-    },
-    Port {
-        name: "count_enable",
-        bits: 1,
-    },
-    Port {
-        name: "count_value",
-        bits: INDEX_BITS as u32,
-    },
-    Port {
-        name: "swap",
-        bits: 1,
-    },
-    Port {
-        name: "swap_last",
-        bits: 32,
-    },
-];
+/// The core's port tables, encoders and decoders, from the spec's port list: one slot per
+/// port in list order (the harness's word order), one `put` per port with a constant slot
+/// (straight-line code), one field of [`CoreInputs`]/[`CoreOutputs`] per port.
+macro_rules! core_layout {
+    (
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        /// The core's inputs, in the harness's word order (the wrapper registers each of them).
+        pub const CORE_INPUTS: [Port; [$($(stringify!($i)),*),*].len()] =
+            [$($( Port { name: stringify!($i), bits: $ib }, )*)*];
 
-/// The core's outputs, in [`crate::cosim::Register`] order.
-pub const CORE_OUTPUTS: [Port; 20] = [
-    Port {
-        name: "x",
-        bits: X_BITS as u32,
-    },
-    Port {
-        name: "v",
-        bits: V_BITS as u32,
-    },
-    Port {
-        name: "a",
-        bits: A_BITS as u32,
-    },
-    Port {
-        name: "j",
-        bits: J_BITS as u32,
-    },
-    Port {
-        name: "position",
-        bits: POSITION_BITS as u32,
-    },
-    Port {
-        name: "segment",
-        bits: INDEX_BITS as u32,
-    },
-    Port {
-        name: "busy",
-        bits: 1,
-    },
-    Port {
-        name: "done",
-        bits: 1,
-    },
-    Port {
-        name: "aborted",
-        bits: 1,
-    },
-    Port {
-        name: "stopping",
-        bits: 1,
-    },
-    Port {
-        name: "stop_over",
-        bits: 1,
-    },
-    Port {
-        name: "tick",
-        bits: 1,
-    },
-    Port {
-        name: "heading_pos",
-        bits: 1,
-    },
-    Port {
-        name: "heading_neg",
-        bits: 1,
-    },
-    Port {
-        name: "at_rest",
-        bits: 1,
-    },
-    Port {
-        name: "active_bank",
-        bits: 1,
-    },
-    Port {
-        name: "standby_count",
-        bits: INDEX_BITS as u32,
-    },
-    Port {
-        name: "tick_count",
-        bits: TICK_BITS as u32,
-    },
-    Port {
-        name: "ticks",
-        bits: 64,
-    },
-    Port {
-        name: "swap_pending",
-        bits: 1,
-    },
-];
+        /// The core's outputs, in [`crate::cosim::Register`] order.
+        pub const CORE_OUTPUTS: [Port; [$($(stringify!($o)),*),*].len()] =
+            [$($( Port { name: stringify!($o), bits: $ob }, )*)*];
 
-const IN_LAYOUT: ([Slot; 17], usize) = pack(&CORE_INPUTS);
-const OUT_LAYOUT: ([Slot; 20], usize) = pack(&CORE_OUTPUTS);
+        /// Each output's raw bits in [`CoreOutputs`], by register.
+        pub(crate) const OUTPUT_BITS: [fn(&CoreOutputs) -> u128; CORE_OUTPUTS.len()] =
+            [$($( |o: &CoreOutputs| PortValue::to_word(o.$o), )*)*];
+
+        /// The inputs in the harness's word layout.
+        #[inline(always)]
+        pub fn encode_inputs(i: &CoreInputs) -> [u32; IN_WORDS] {
+            let mut w = [0u32; IN_WORDS];
+            let mut k = 0;
+            $($( IN_SLOTS[k].put(&mut w, PortValue::to_word(i.$i)); k += 1; )*)*
+            debug_assert_eq!(k, IN_SLOTS.len());
+            w
+        }
+
+        /// Encodes outputs in the harness's word layout (the inverse of [`decode`]): what the
+        /// co-simulation compares the fabric's words with, on every clock.
+        #[inline(always)]
+        pub fn encode(o: &CoreOutputs) -> [u32; OUT_WORDS] {
+            let mut w = [0u32; OUT_WORDS];
+            let mut k = 0;
+            $($( OUT_SLOTS[k].put(&mut w, PortValue::to_word(o.$o)); k += 1; )*)*
+            debug_assert_eq!(k, OUT_SLOTS.len());
+            w
+        }
+
+        /// Decodes one clock's output words.
+        pub fn decode(w: &[u32]) -> CoreOutputs {
+            let mut k = 0;
+            $($( let $o = PortValue::from_word(OUT_SLOTS[k].get(w), $ob); k += 1; )*)*
+            debug_assert_eq!(k, OUT_SLOTS.len());
+            CoreOutputs { $($( $o, )*)* }
+        }
+    };
+}
+
+snapgen_spec::with_motion_core_ports!(core_layout! {});
+
+const IN_LAYOUT: ([Slot; CORE_INPUTS.len()], usize) = pack(&CORE_INPUTS);
+const OUT_LAYOUT: ([Slot; CORE_OUTPUTS.len()], usize) = pack(&CORE_OUTPUTS);
 /// Where each input is in the input words.
-pub const IN_SLOTS: [Slot; 17] = IN_LAYOUT.0;
+pub const IN_SLOTS: [Slot; CORE_INPUTS.len()] = IN_LAYOUT.0;
 /// Where each output is in a clock's output words.
-pub const OUT_SLOTS: [Slot; 20] = OUT_LAYOUT.0;
+pub const OUT_SLOTS: [Slot; CORE_OUTPUTS.len()] = OUT_LAYOUT.0;
 /// Input words per `set` call.
 pub const IN_WORDS: usize = IN_LAYOUT.1;
 /// Output words per clock.
@@ -287,103 +181,5 @@ impl Drop for Fabric {
     fn drop(&mut self) {
         // SAFETY: `handle` came from `snapgen_core_new` and is freed once.
         unsafe { (self.free)(self.handle) }
-    }
-}
-
-/// The inputs in the harness's word layout.
-pub fn encode_inputs(i: &CoreInputs) -> [u32; IN_WORDS] {
-    let mut w = [0u32; IN_WORDS];
-    let values: [u128; 17] = [
-        u128::from(i.reset),
-        u128::from(i.tick_div),
-        u128::from(i.start),
-        u128::from(i.abort),
-        u128::from(i.stop),
-        u128::from(i.load),
-        u128::from(i.load_position),
-        i.stop_limits.jerk as u128,
-        i.stop_limits.accel as u128,
-        u128::from(i.write_enable),
-        u128::from(i.write_address),
-        u128::from(i.write_ticks),
-        i.write_snap as u128,
-        u128::from(i.count_enable),
-        u128::from(i.count_value),
-        u128::from(i.swap),
-        u128::from(i.swap_last),
-    ];
-    for (slot, v) in IN_SLOTS.iter().zip(values) {
-        slot.put(&mut w, v);
-    }
-    w
-}
-
-/// Encodes outputs in the harness's word layout (the inverse of [`decode`]): what the
-/// co-simulation compares the fabric's words with, on every clock.
-///
-/// One `put` per register, each with a constant register: every slot, shift and mask then
-/// folds into straight-line code (a loop over the registers did not, and cost three times the
-/// Verilated core's own clock). Every register is written (checked by a test).
-#[inline(always)]
-pub fn encode(o: &CoreOutputs, f: &Format) -> [u32; OUT_WORDS] {
-    use crate::cosim::Register as R;
-    let mut w = [0u32; OUT_WORDS];
-    macro_rules! put {
-        ($($r:expr),* $(,)?) => {
-            $(OUT_SLOTS[$r as usize].put(&mut w, $r.bits_of(o, f));)*
-            const _: () = assert!([$($r as usize),*].len() == R::ALL.len());
-        };
-    }
-    put!(
-        R::X,
-        R::V,
-        R::A,
-        R::J,
-        R::Position,
-        R::Segment,
-        R::Busy,
-        R::Done,
-        R::Aborted,
-        R::Stopping,
-        R::StopOver,
-        R::Tick,
-        R::HeadingPos,
-        R::HeadingNeg,
-        R::AtRest,
-        R::ActiveBank,
-        R::StandbyCount,
-        R::TickCount,
-        R::Ticks,
-        R::SwapPending,
-    );
-    w
-}
-
-/// Decodes one clock's output words.
-pub fn decode(w: &[u32], f: &Format) -> CoreOutputs {
-    use crate::cosim::Register as R;
-    let get = |r: R| OUT_SLOTS[r as usize].get(w);
-    let wide = |r: R, bits: u32| wrap(get(r) as i128, bits);
-    let flag = |r: R| get(r) == 1;
-    CoreOutputs {
-        x: wide(R::X, f.widths.x),
-        v: wide(R::V, f.widths.v),
-        a: wide(R::A, f.widths.a),
-        j: wide(R::J, f.widths.j),
-        position: get(R::Position) as u32,
-        segment: get(R::Segment) as u8,
-        busy: flag(R::Busy),
-        done: flag(R::Done),
-        aborted: flag(R::Aborted),
-        stopping: flag(R::Stopping),
-        stop_over: flag(R::StopOver),
-        tick: flag(R::Tick),
-        heading: i8::from(flag(R::HeadingPos)) - i8::from(flag(R::HeadingNeg)),
-        at_rest: flag(R::AtRest),
-        active_bank: flag(R::ActiveBank),
-        standby_count: get(R::StandbyCount) as u8,
-        tick_count: get(R::TickCount) as u32,
-        ticks: get(R::Ticks) as u64,
-        swap_pending: flag(R::SwapPending),
     }
 }

@@ -2,8 +2,8 @@
 //! rate, byte by byte, and time is the board's own (its clocks), so a latency measured here is
 //! the one the design's UART gives, to the clock.
 
-use snapgen_model::axis::driver::{Link, LinkError};
-use snapgen_model::protocol::{Command, Decoded, Decoder, Reply};
+use snapgen_host::axis::driver::{Link, LinkError};
+use snapgen_host::protocol::{Command, Decoded, Decoder, Reply};
 
 use crate::board::VirtualBoard;
 

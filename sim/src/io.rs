@@ -9,104 +9,105 @@ use std::ffi::{c_char, c_void, CString};
 use std::path::Path;
 
 use libloading::Library;
-use snapgen_hdl::status_block::STATUS_BITS;
 use snapgen_model::device::{IoInputs, IoOutputs};
-use snapgen_model::protocol::{payload_bytes, Status, STATUS_FIELDS};
+use snapgen_spec::fields::{Status, STATUS_BITS, STATUS_FIELDS};
 
 use crate::fabric::VcdWindow;
 use crate::layout::{harness_header, pack, Port, Slot};
 use crate::SimError;
 
-/// The I/O top's inputs, in the harness's word order.
-pub const IO_INPUTS: [Port; 8] = [
-    Port {
-        name: "reset",
-        bits: 1,
-    },
-    Port {
-        name: "uart_rx",
-        bits: 1,
-    },
-    Port {
-        name: "enc_a",
-        bits: 1,
-    },
-    Port {
-        name: "enc_b",
-        bits: 1,
-    },
-    Port {
-        name: "enc_i",
-        bits: 1,
-    },
-    Port {
-        name: "limit_pos",
-        bits: 1,
-    },
-    Port {
-        name: "limit_neg",
-        bits: 1,
-    },
-    Port {
-        name: "estop",
-        bits: 1,
-    },
-];
+/// The I/O top's port tables, encoders and decoder, from the spec's port list (one slot per
+/// port in list order; the status block takes whole words of its own).
+macro_rules! io_layout {
+    (
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        /// The I/O top's inputs, in the harness's word order.
+        pub const IO_INPUTS: [Port; [$($(stringify!($i)),*),*].len()] =
+            [$($( Port { name: stringify!($i), bits: $ib }, )*)*];
 
-/// The I/O top's outputs, in [`IoSignal`] order (the status block last).
-pub const IO_OUTPUTS: [Port; 9] = [
-    Port {
-        name: "uart_tx",
-        bits: 1,
-    },
-    Port {
-        name: "pwm",
-        bits: 1,
-    },
-    Port {
-        name: "dir",
-        bits: 1,
-    },
-    Port {
-        name: "amplifier",
-        bits: 1,
-    },
-    Port {
-        name: "led_idle",
-        bits: 1,
-    },
-    Port {
-        name: "led_busy",
-        bits: 1,
-    },
-    Port {
-        name: "led_fault",
-        bits: 1,
-    },
-    Port {
-        name: "led_heartbeat",
-        bits: 1,
-    },
-    Port {
-        name: "status",
-        bits: STATUS_BITS as u32,
-    },
-];
+        /// The I/O top's outputs, in the harness's word order (the status block last).
+        pub const IO_OUTPUTS: [Port; [$($(stringify!($o)),*),*].len()] =
+            [$($( Port { name: stringify!($o), bits: $ob }, )*)*];
 
-const IN_LAYOUT: ([Slot; 8], usize) = pack(&IO_INPUTS);
-const OUT_LAYOUT: ([Slot; 9], usize) = pack(&IO_OUTPUTS);
+        /// A clock's pins in the harness's layout.
+        pub fn encode_inputs(i: &IoInputs) -> [u32; IN_WORDS] {
+            let mut w = [0u32; IN_WORDS];
+            let mut k = 0;
+            $($( Packed::pack(i.$i, &IN_SLOTS[k], &mut w); k += 1; )*)*
+            debug_assert_eq!(k, IN_SLOTS.len());
+            w
+        }
+
+        /// A clock's outputs in the harness's layout.
+        pub fn encode_outputs(o: &IoOutputs) -> [u32; OUT_WORDS] {
+            let mut w = [0u32; OUT_WORDS];
+            let mut k = 0;
+            $($( Packed::pack(o.$o, &OUT_SLOTS[k], &mut w); k += 1; )*)*
+            debug_assert_eq!(k, OUT_SLOTS.len());
+            w
+        }
+
+        /// Decodes a clock's output words.
+        pub fn decode_outputs(w: &[u32]) -> IoOutputs {
+            let mut k = 0;
+            $($( let $o = Packed::unpack(&OUT_SLOTS[k], w); k += 1; )*)*
+            debug_assert_eq!(k, OUT_SLOTS.len());
+            IoOutputs { $($( $o, )*)* }
+        }
+    };
+}
+
+snapgen_spec::with_io_top_ports!(io_layout! {});
+
+/// A value of an I/O top port in the harness's words: a pin, or the status block (its bytes
+/// from the slot's first word up, byte 0 in bits 7:0).
+trait Packed: Sized {
+    fn pack(self, slot: &Slot, w: &mut [u32]);
+    fn unpack(slot: &Slot, w: &[u32]) -> Self;
+}
+
+impl Packed for bool {
+    fn pack(self, slot: &Slot, w: &mut [u32]) {
+        slot.put(w, u128::from(self));
+    }
+    fn unpack(slot: &Slot, w: &[u32]) -> Self {
+        slot.get(w) == 1
+    }
+}
+
+impl Packed for Status {
+    fn pack(self, slot: &Slot, w: &mut [u32]) {
+        for (k, b) in self.to_payload().into_iter().enumerate() {
+            w[slot.word + k / 4] |= u32::from(b) << (8 * (k % 4));
+        }
+    }
+    fn unpack(slot: &Slot, w: &[u32]) -> Self {
+        let bytes: Vec<u8> = (0..Status::BYTES)
+            .map(|k| (w[slot.word + k / 4] >> (8 * (k % 4))) as u8)
+            .collect();
+        Status::from_payload(&bytes).expect("the status block's length")
+    }
+}
+
+const IN_LAYOUT: ([Slot; IO_INPUTS.len()], usize) = pack(&IO_INPUTS);
+const OUT_LAYOUT: ([Slot; IO_OUTPUTS.len()], usize) = pack(&IO_OUTPUTS);
 /// Where each input is in a clock's input words.
-pub const IN_SLOTS: [Slot; 8] = IN_LAYOUT.0;
+pub const IN_SLOTS: [Slot; IO_INPUTS.len()] = IN_LAYOUT.0;
 /// Where each output is in a clock's output words.
-pub const OUT_SLOTS: [Slot; 9] = OUT_LAYOUT.0;
+pub const OUT_SLOTS: [Slot; IO_OUTPUTS.len()] = OUT_LAYOUT.0;
 /// Input words per clock.
 pub const IN_WORDS: usize = IN_LAYOUT.1;
 /// Output words per clock.
 pub const OUT_WORDS: usize = OUT_LAYOUT.1;
+/// The status block's port.
+const STATUS_PORT: usize = IO_OUTPUTS.len() - 1;
 /// Where the status block starts in a clock's output words.
-const STATUS_WORD: usize = OUT_SLOTS[8].word;
+const STATUS_WORD: usize = OUT_SLOTS[STATUS_PORT].word;
 
-const _: () = assert!(8 * payload_bytes(&STATUS_FIELDS) == STATUS_BITS);
+const _: () = assert!(IO_OUTPUTS[STATUS_PORT].bits as usize == STATUS_BITS);
 
 /// The harness's generated header (`snapgen_layout.h`).
 pub fn io_layout_header() -> String {
@@ -125,7 +126,7 @@ pub enum IoSignal {
 impl IoSignal {
     /// Every compared signal.
     pub fn all() -> impl Iterator<Item = IoSignal> {
-        (0..8)
+        (0..STATUS_PORT)
             .map(IoSignal::Pin)
             .chain((0..STATUS_FIELDS.len()).map(IoSignal::Status))
     }
@@ -191,25 +192,6 @@ fn status_bytes(w: &[u32]) -> Vec<u8> {
         .collect()
 }
 
-/// A clock's pins in the harness's layout.
-pub fn encode_inputs(i: &IoInputs) -> [u32; IN_WORDS] {
-    let mut w = [0u32; IN_WORDS];
-    let values = [
-        i.reset,
-        i.uart_rx,
-        i.enc_a,
-        i.enc_b,
-        i.enc_i,
-        i.limit_positive,
-        i.limit_negative,
-        i.emergency_stop,
-    ];
-    for (slot, v) in IN_SLOTS.iter().zip(values) {
-        slot.put(&mut w, u128::from(v));
-    }
-    w
-}
-
 /// The first signal whose value differs between the fabric's outputs `got` and the model's
 /// `want`: (signal, model's value, fabric's value). Every output bit belongs to a signal
 /// (tested), so equal signals mean equal vectors.
@@ -220,44 +202,6 @@ pub fn first_difference(got: &[u32], want: &[u32]) -> Option<(IoSignal, u128, u1
     IoSignal::all()
         .find(|s| s.value(got) != s.value(want))
         .map(|s| (s, s.value(want), s.value(got)))
-}
-
-/// A clock's outputs in the harness's layout.
-pub fn encode_outputs(o: &IoOutputs) -> [u32; OUT_WORDS] {
-    let mut w = [0u32; OUT_WORDS];
-    let pins = [
-        o.uart_tx,
-        o.pwm,
-        o.dir,
-        o.amplifier,
-        o.led_idle,
-        o.led_busy,
-        o.led_fault,
-        o.led_heartbeat,
-    ];
-    for (slot, v) in OUT_SLOTS.iter().zip(pins) {
-        slot.put(&mut w, u128::from(v));
-    }
-    for (k, b) in o.status.to_payload().into_iter().enumerate() {
-        w[STATUS_WORD + k / 4] |= u32::from(b) << (8 * (k % 4));
-    }
-    w
-}
-
-/// Decodes a clock's output words.
-pub fn decode_outputs(w: &[u32]) -> IoOutputs {
-    let pin = |k: usize| OUT_SLOTS[k].get(w) == 1;
-    IoOutputs {
-        uart_tx: pin(0),
-        pwm: pin(1),
-        dir: pin(2),
-        amplifier: pin(3),
-        led_idle: pin(4),
-        led_busy: pin(5),
-        led_fault: pin(6),
-        led_heartbeat: pin(7),
-        status: Status::from_payload(&status_bytes(w)).expect("the status block's length"),
-    }
 }
 
 type NewFn = unsafe extern "C" fn(*const c_char, u64, u64) -> *mut c_void;
@@ -350,7 +294,7 @@ impl Drop for FabricIo {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use snapgen_model::protocol::flag;
+    use snapgen_host::protocol::flag;
 
     #[test]
     fn outputs_round_trip_and_every_bit_is_a_signal() {

@@ -19,15 +19,16 @@ use std::time::Instant;
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
-use snapgen_model::format::Quantity;
-use snapgen_model::peer::Peer;
-use snapgen_model::protocol::{
+use snapgen_host::protocol::{
     code, flag, AxisState, Command, Decoded, Decoder, ErrorId, Frame, Param, Reason, Reply, Status,
     DEVICE_MAX_PAYLOAD, START,
 };
+use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
+use snapgen_model::format::Quantity;
+use snapgen_model::peer::Peer;
 use snapgen_model::timing::Dividers;
-use snapgen_model::{plan_from, Format, Method, MoveRequest, Segment, DEFAULT_FORMAT};
+use snapgen_model::{Format, Segment, DEFAULT_FORMAT};
+use snapgen_plan::{plan_from, Method, MoveRequest};
 
 use crate::build::build_io;
 use crate::fabric::VcdWindow;
@@ -424,7 +425,7 @@ impl Stream {
                 // A good CRC on an unknown command.
                 let cmd = loop {
                     let c = r.gen::<u8>();
-                    if snapgen_model::protocol::command_spec(c).is_none() {
+                    if snapgen_host::protocol::command_spec(c).is_none() {
                         break c;
                     }
                 };
@@ -690,7 +691,7 @@ impl Stream {
                                 | Reason::UnknownCommand
                         );
                         if !frame_level
-                            && !snapgen_model::protocol::refusal_documented(cmd, reason)
+                            && !snapgen_spec::refusals::refusal_documented(cmd, reason)
                             && !self.report.undocumented.contains(&(cmd, reason as u8))
                         {
                             self.report.undocumented.push((cmd, reason as u8));
@@ -736,7 +737,7 @@ fn stop_limits(r: &mut StdRng) -> (i128, i128) {
 
 /// Any command with random arguments (good and bad).
 fn random_command(r: &mut StdRng, f: &Format, ticks: u64) -> Command {
-    let n = snapgen_model::protocol::PARAMS.len() as u8;
+    let n = snapgen_spec::PARAMS.len() as u8;
     let param = Param::from_byte(r.gen_range(1..=n)).expect("1..=n are parameters");
     match r.gen_range(0..13) {
         0 => Command::Ping,

@@ -16,6 +16,54 @@ pub struct Port {
     pub bits: u32,
 }
 
+/// A model port value as a port's raw bits and back (`bits`: the port's width; signed values
+/// are two's complement and sign-extended when read).
+pub trait PortValue: Copy {
+    /// The raw bits (the slot keeps the port's width of them).
+    fn to_word(self) -> u128;
+    /// From a port's raw bits.
+    fn from_word(v: u128, bits: u32) -> Self;
+}
+
+impl PortValue for bool {
+    #[inline(always)]
+    fn to_word(self) -> u128 {
+        u128::from(self)
+    }
+    #[inline(always)]
+    fn from_word(v: u128, _: u32) -> Self {
+        v & 1 == 1
+    }
+}
+
+macro_rules! unsigned_port_value {
+    ($($t:ty),*) => {$(
+        impl PortValue for $t {
+            #[inline(always)]
+            fn to_word(self) -> u128 {
+                self as u128
+            }
+            #[inline(always)]
+            fn from_word(v: u128, _: u32) -> Self {
+                v as $t
+            }
+        }
+    )*};
+}
+
+unsigned_port_value!(u8, u16, u32, u64);
+
+impl PortValue for i128 {
+    #[inline(always)]
+    fn to_word(self) -> u128 {
+        self as u128
+    }
+    #[inline(always)]
+    fn from_word(v: u128, bits: u32) -> Self {
+        snapgen_model::chain::wrap(v as i128, bits)
+    }
+}
+
 /// Where a port's bits are in the word array.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Slot {

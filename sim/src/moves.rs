@@ -12,7 +12,8 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use snapgen_model::format::Quantity;
 use snapgen_model::stop::StopLimits;
-use snapgen_model::{Format, Method, MoveRequest};
+use snapgen_model::Format;
+use snapgen_plan::{Method, MoveRequest};
 
 /// Which planners the stream uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

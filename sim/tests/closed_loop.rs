@@ -5,12 +5,13 @@
 
 use std::f64::consts::PI;
 
+use snapgen_host::protocol::Reason;
+use snapgen_host::protocol::{flag, AxisState, Command, ErrorId, Reply};
 use snapgen_model::device::Design;
-use snapgen_model::protocol::Reason;
-use snapgen_model::protocol::{flag, AxisState, Command, ErrorId, Reply};
 use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
-use snapgen_model::{plan_from, ChainState, Format, Method, MoveRequest, Quantity, DEFAULT_FORMAT};
+use snapgen_model::{ChainState, Format, Quantity, DEFAULT_FORMAT};
+use snapgen_plan::{plan_from, Method, MoveRequest};
 use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
 use snapgen_plant::metrics::{figures, MoveSpan};
@@ -202,7 +203,7 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     // it must see the loaded reference, not the one the motor coasted away from (which is
     // past the following limit and would trip the fault again at once).
     l.command(Command::Configure {
-        param: snapgen_model::protocol::Param::TickDivider,
+        param: snapgen_host::protocol::Param::TickDivider,
         value: 0,
     })
     .unwrap();
@@ -214,14 +215,14 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     // The reference is tens of counts from the motor: well past a limit of 10.
     assert!((st.position - st.encoder).abs() > 20, "{st:?}");
     l.command(Command::Configure {
-        param: snapgen_model::protocol::Param::FollowingLimit,
+        param: snapgen_host::protocol::Param::FollowingLimit,
         value: 10,
     })
     .unwrap();
     l.command(Command::Power { on: true }).unwrap();
     l.run(5_000);
     l.command(Command::Configure {
-        param: snapgen_model::protocol::Param::TickDivider,
+        param: snapgen_host::protocol::Param::TickDivider,
         value: i128::from(d.dividers.tick_div),
     })
     .unwrap();
@@ -303,7 +304,7 @@ fn a_new_tick_divider_ticks_on_the_same_clock_in_fabric_and_model() {
     l.setup(&s).unwrap();
     for div in [9, 99, 4, 57, 9] {
         l.command(Command::Configure {
-            param: snapgen_model::protocol::Param::TickDivider,
+            param: snapgen_host::protocol::Param::TickDivider,
             value: div,
         })
         .unwrap();

@@ -6,6 +6,11 @@ use snapgen_sim::cosim::{run, CosimConfig, Fault, Register};
 use snapgen_sim::moves::OrderMix;
 use snapgen_sim::SimError;
 
+/// The compared register called `name`.
+fn reg(name: &str) -> Register {
+    Register::named(name).unwrap_or_else(|| panic!("no register {name}"))
+}
+
 fn verilog() -> String {
     snapgen_hdl::verilog::motion_core_verilog()
 }
@@ -208,10 +213,10 @@ fn a_flipped_bit_is_reported_with_waves() {
     let dir = std::env::temp_dir().join(format!("snapgen-fault-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (clock, register, bit) in [
-        (5_000u64, Register::X, 3u32),
-        (7_777, Register::J, 101),
-        (12_345, Register::Busy, 0),
-        (9_000, Register::TickCount, 31),
+        (5_000u64, reg("x"), 3u32),
+        (7_777, reg("j"), 101),
+        (12_345, reg("busy"), 0),
+        (9_000, reg("tick_count"), 31),
     ] {
         let mut c = quiet(40, 5);
         // The fault lands in session 0: two sessions give it 20 moves, long past these clocks.
@@ -253,7 +258,7 @@ fn a_fault_never_reached_is_an_error() {
     let mut c = quiet(4, 5);
     c.fault = Some(Fault {
         clock: 1 << 40,
-        register: Register::X,
+        register: reg("x"),
         bit: 0,
     });
     match run(&verilog(), &c) {

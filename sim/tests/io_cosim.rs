@@ -1,7 +1,7 @@
 //! Co-simulation of the Verilated I/O top against the device model, clock by clock, under
 //! random command streams (needs Verilator; the README's test command installs it).
 
-use snapgen_model::protocol::{code, ErrorId, Reason};
+use snapgen_host::protocol::{code, ErrorId, Reason};
 use snapgen_sim::io::IoSignal;
 use snapgen_sim::io_cosim::{cosim_design, describe, run, IoCosimConfig, IoCosimReport, IoFault};
 

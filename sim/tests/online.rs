@@ -3,14 +3,14 @@
 //! poll against the host's prediction by the driver, and here against an independent tick by
 //! tick replay of what the board played.
 
-use snapgen_model::axis::driver::{
+use snapgen_host::axis::driver::{
     power_up, run, stop_limits, Action, Event, RunOptions, RunReport,
 };
-use snapgen_model::axis::{AxisErrorId, AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
+use snapgen_host::axis::{AxisErrorId, AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
 use snapgen_model::device::Design;
-use snapgen_model::online::OnlineOrder;
 use snapgen_model::timing::Timing;
 use snapgen_model::{ChainState, DEFAULT_FORMAT};
+use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::BoardLink;
 

@@ -246,6 +246,8 @@ pub struct FlagSpec {
     pub bit: u32,
     /// Name.
     pub name: &'static str,
+    /// The fabric signal that sets it.
+    pub port: &'static str,
     /// Meaning.
     pub meaning: &'static str,
 }
@@ -257,8 +259,33 @@ impl FlagSpec {
     }
 }
 
-macro_rules! flags {
-    ( $( $name:ident = $bit:literal, $meaning:literal; )* ) => {
+/// Calls `$callback! { $($extra)* $( NAME = bit, port, "meaning"; )* }` with every status flag:
+/// its name, its bit in `flags` and the name of the fabric signal that sets it (the status
+/// block's input).
+#[macro_export]
+macro_rules! with_flags {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            PLAYING = 0, playing, "a program plays";
+            DONE = 1, done, "the last program ran to its end";
+            CUT = 2, cut, "the last program was cut short (a stop or the emergency stop)";
+            STOPPING = 3, stopping, "a controlled stop is requested or runs";
+            STOP_OVER_LIMITS = 4, stop_over, "the last stop left its limits on some tick (it began outside them; it still landed exactly)";
+            AMPLIFIER = 5, amplifier, "the amplifier is enabled";
+            LIMIT_POSITIVE = 6, limit_pos, "the positive limit input is active (after polarity and filter)";
+            LIMIT_NEGATIVE = 7, limit_neg, "the negative limit input is active";
+            EMERGENCY_STOP = 8, estop, "the emergency-stop input is active";
+            ENCODER_ERROR = 9, encoder_error, "an illegal encoder transition was seen (since reset or the last RESET command)";
+            UART_ERROR = 10, uart_error, "a UART framing error was seen (since reset or the last RESET command)";
+            REPLY_OVERFLOW = 11, reply_overflow, "a frame was dropped with the reply queue full (since reset or the last RESET command)";
+            SERVO_OVERRUN = 12, servo_overrun, "the controller skipped a sample, still computing the last one (samples {SERVO_LATENCY} clocks apart or less: SERVO_PERIOD × clocks per tick ≤ {SERVO_LATENCY}; since reset or the last RESET command)";
+            SWAP_PENDING = 13, swap_pending, "a program swap is armed (SWAP_AT accepted, its tick not reached yet)";
+        }
+    };
+}
+
+macro_rules! flag_table {
+    ( $( $name:ident = $bit:literal, $port:ident, $meaning:literal; )* ) => {
         /// Bits of `flags` in the status block.
         pub mod flag {
             $( #[doc = $meaning] pub const $name: u16 = 1 << $bit; )*
@@ -266,27 +293,12 @@ macro_rules! flags {
 
         /// Every flag, in bit order (docs/PROTOCOL.md, "Status block").
         pub const FLAGS: [FlagSpec; [$($bit),*].len()] = [
-            $( FlagSpec { bit: $bit, name: stringify!($name), meaning: $meaning }, )*
+            $( FlagSpec { bit: $bit, name: stringify!($name), port: stringify!($port), meaning: $meaning }, )*
         ];
     };
 }
 
-flags! {
-    PLAYING = 0, "a program plays";
-    DONE = 1, "the last program ran to its end";
-    CUT = 2, "the last program was cut short (a stop or the emergency stop)";
-    STOPPING = 3, "a controlled stop is requested or runs";
-    STOP_OVER_LIMITS = 4, "the last stop left its limits on some tick (it began outside them; it still landed exactly)";
-    AMPLIFIER = 5, "the amplifier is enabled";
-    LIMIT_POSITIVE = 6, "the positive limit input is active (after polarity and filter)";
-    LIMIT_NEGATIVE = 7, "the negative limit input is active";
-    EMERGENCY_STOP = 8, "the emergency-stop input is active";
-    ENCODER_ERROR = 9, "an illegal encoder transition was seen (since reset or the last RESET command)";
-    UART_ERROR = 10, "a UART framing error was seen (since reset or the last RESET command)";
-    REPLY_OVERFLOW = 11, "a frame was dropped with the reply queue full (since reset or the last RESET command)";
-    SERVO_OVERRUN = 12, "the controller skipped a sample, still computing the last one (samples {SERVO_LATENCY} clocks apart or less: SERVO_PERIOD × clocks per tick ≤ {SERVO_LATENCY}; since reset or the last RESET command)";
-    SWAP_PENDING = 13, "a program swap is armed (SWAP_AT accepted, its tick not reached yet)";
-}
+with_flags!(flag_table! {});
 
 impl crate::fields::Status {
     /// The axis state.

@@ -58,6 +58,27 @@ pub const fn payload_bytes(fields: &[Field]) -> usize {
     }
 }
 
+/// The field called `name` in `table` (a compile-time lookup: an unknown name stops the
+/// build).
+pub const fn field(table: &[Field], name: &str) -> Field {
+    let mut k = 0;
+    while k < table.len() {
+        let a = table[k].name.as_bytes();
+        let b = name.as_bytes();
+        if a.len() == b.len() {
+            let mut i = 0;
+            while i < a.len() && a[i] == b[i] {
+                i += 1;
+            }
+            if i == a.len() {
+                return table[k];
+            }
+        }
+        k += 1;
+    }
+    panic!("no field of that name in the layout")
+}
+
 /// Writes `value` (two's complement, little-endian, truncated to the field) into `field` of
 /// `out`.
 pub fn put(out: &mut [u8], field: &Field, value: i128) {
@@ -95,6 +116,13 @@ macro_rules! payload {
         $name:ident, $table:ident {
             $( $field:ident : $ty:ty = $bytes:expr, $sign:ident, $meaning:literal; )*
         }
+    ) => {
+        $crate::payload! { $(#[$meta])* $name, $table $( $field : $ty = $bytes, $sign, $meaning; )* }
+    };
+    (
+        $(#[$meta:meta])*
+        $name:ident, $table:ident
+            $( $field:ident : $ty:ty = $bytes:expr, $sign:ident, $meaning:literal; )*
     ) => {
         #[doc = concat!("The layout of [`", stringify!($name), "`].")]
         pub const $table: [$crate::fields::Field; [$(stringify!($field)),*].len()] =
@@ -134,9 +162,13 @@ macro_rules! payload {
     };
 }
 
-payload! {
-    /// The status block (STATUS, TELEMETRY).
-    Status, STATUS_FIELDS {
+/// Calls `$callback! { $($extra)* $( field: RustType = bytes, signed|unsigned, "meaning"; )* }`
+/// with the status block's fields, in order: the one list of them (the fabric's status block
+/// takes one input per field).
+#[macro_export]
+macro_rules! with_status_fields {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
         state: u8 = 1, unsigned, "axis state (above)";
         error: u8 = 1, unsigned, "error identifier (above)";
         flags: u16 = 2, unsigned, "flag bits (below)";
@@ -148,8 +180,14 @@ payload! {
         bad_frames: u16 = 2, unsigned, "frames with a bad length or an unknown command, cut short by the inter-byte timeout or by a UART framing error (wraps)";
         following_peak: u32 = 4, unsigned, "the largest magnitude of the following error at a controller sample since the last START or reset, counts · 2^-{E_FRAC} (saturates at 2^31)";
         duty: i16 = 2, signed, "the controller's duty now, PWM clocks, signed (its sign is the direction)";
-    }
+        }
+    };
 }
+
+with_status_fields!(payload! {
+    /// The status block (STATUS, TELEMETRY).
+    Status, STATUS_FIELDS
+});
 
 payload! {
     /// What a device says about itself (IDENTITY, the reply to PING).
@@ -241,6 +279,13 @@ payload! {
     NakPayload, NAK_FIELDS {
         cmd: u8 = 1, unsigned, "the rejected command's code (0 if unknown)";
         reason: u8 = 1, unsigned, "reason";
+    }
+}
+
+impl Identity {
+    /// The tick period it reports (s): `(tick_divider + 1) / clock_hz`.
+    pub fn ts(&self) -> f64 {
+        (f64::from(self.tick_divider) + 1.0) / f64::from(self.clock_hz)
     }
 }
 

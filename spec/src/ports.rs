@@ -15,7 +15,7 @@
 //! (`snapgen_model`), the co-simulation its word layouts and harness header (`snapgen_sim`);
 //! [`MOTION_CORE`] and [`IO_TOP`] are the same lists as tables, for the generators. Sections
 //! let a block take part of another's list: the executor drives the core's `command` inputs
-//! and reads its `status` outputs.
+//! and reads its `status` outputs; the status block reads the `report` outputs.
 //!
 //! The I/O top's `axis` sections are per axis: a design with several axes repeats them, and
 //! [`board_pins`] numbers them.
@@ -128,11 +128,7 @@ macro_rules! with_motion_core_ports {
                 }
                 status {
                     busy: bit[1] bool, "A program is playing.";
-                    done: bit[1] bool, "The last program ran to its end.";
-                    aborted: bit[1] bool, "The last program was cut short (by a stop or an abort).";
                     stopping: bit[1] bool, "A controlled stop is requested or running.";
-                    stop_over: bit[1] bool, "The last stop began outside its limits (and landed regardless of them).";
-                    tick_count: bits[$crate::widths::TICK_BITS] u32, "Ticks since the start, while a program plays or a stop runs.";
                     ticks: bits[$crate::widths::TIME_BITS] u64, "Ticks since reset: the board's time base.";
                     heading_pos: bit[1] bool, "The axis heads forward (registered): on the last clock the first non-zero of v, a, j was positive.";
                     heading_neg: bit[1] bool, "The axis heads backward (registered).";
@@ -140,6 +136,12 @@ macro_rules! with_motion_core_ports {
                     tick: bit[1] bool, "The tick enable (one clock wide).";
                     standby_count: bits[$crate::widths::INDEX_BITS] u8, "Segment count of the standby program (0: nothing to start).";
                     swap_pending: bit[1] bool, "A program swap is armed.";
+                }
+                report {
+                    done: bit[1] bool, "The last program ran to its end.";
+                    aborted: bit[1] bool, "The last program was cut short (by a stop or an abort).";
+                    stop_over: bit[1] bool, "The last stop began outside its limits (and landed regardless of them).";
+                    tick_count: bits[$crate::widths::TICK_BITS] u32, "Ticks since the start, while a program plays or a stop runs.";
                 }
                 debug {
                     segment: bits[$crate::widths::INDEX_BITS] u8, "Segment playing.";
@@ -187,7 +189,7 @@ macro_rules! with_io_top_ports {
                     amplifier: bit[1] bool, "Amplifier enable (low: the amplifier must not drive the motor).";
                 }
                 debug {
-                    status: bits[$crate::fields::STATUS_BITS as u32] u8, "The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits 7:0: for co-simulation and debugging.";
+                    status: bits[$crate::fields::STATUS_BITS as u32] $crate::fields::Status, "The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits 7:0: for co-simulation and debugging.";
                 }
             }
         }

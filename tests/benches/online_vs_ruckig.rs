@@ -1,4 +1,4 @@
-//! One online replan (`snapgen_model::online::plan_online`) against Ruckig (`rsruckig`) from
+//! One online replan (`snapgen_plan::online::plan_online`) against Ruckig (`rsruckig`) from
 //! the same moving states, in one process: criterion's timing of both over the whole set, then
 //! the time of every single plan (its median over the states, the mean and the 90th
 //! percentile) for each, and the ratios.
@@ -22,8 +22,8 @@ use std::time::Instant;
 use criterion::Criterion;
 use rand::{Rng, SeedableRng};
 use rsruckig::prelude::*;
-use snapgen_model::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
 use snapgen_model::{ChainState, Format, Quantity, FRAC_BITS};
+use snapgen_plan::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
 
 const STATES: usize = 5_000;
 /// Plans of one state timed as one block.

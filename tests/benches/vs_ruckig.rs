@@ -15,7 +15,8 @@ use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rsruckig::prelude::*;
-use snapgen_model::{plan, plan_into, ChainState, Format, Method, MoveRequest};
+use snapgen_model::{ChainState, Format};
+use snapgen_plan::{plan, plan_into, Method, MoveRequest};
 
 /// Moves in the set.
 const MOVES: usize = 20_000;

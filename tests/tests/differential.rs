@@ -11,7 +11,8 @@
 mod util;
 
 use proptest::prelude::*;
-use snapgen_model::{plan, Format, Method, MoveRequest, Quantity, Trace};
+use snapgen_model::{Format, Quantity, Trace};
+use snapgen_plan::{plan, Method, MoveRequest};
 
 /// Integrates a piecewise-constant snap profile exactly (Taylor polynomials per piece):
 /// returns the final (x, v, a, j) and the peaks of |v|, |a|, |j| (checked at piece ends and

@@ -6,10 +6,8 @@ mod util;
 use std::f64::consts::PI;
 
 use ethnum::I256;
-use snapgen_model::{
-    plan, plan_from, Format, Method, MoveRequest, PhaseTicks, Plan, PlanError, Quantity,
-    DEFAULT_FORMAT,
-};
+use snapgen_model::{Format, Quantity, DEFAULT_FORMAT};
+use snapgen_plan::{plan, plan_from, Method, MoveRequest, PhaseTicks, Plan, PlanError};
 use util::{assert_plan_promises, integrated, peak_physical, traced};
 
 fn ok(distance: f64, method: Method, f: &Format) -> Plan {

@@ -1,4 +1,4 @@
-//! Online planning from arbitrary states (`snapgen_model::online`), checked from outside:
+//! Online planning from arbitrary states (`snapgen_plan::online`), checked from outside:
 //!
 //! * the program is stepped here, tick by tick (`x += v; v += a; a += j; j += d`), from the
 //!   start registers — nothing the planner computes about its own program is read;
@@ -19,11 +19,11 @@ mod util;
 
 use proptest::prelude::*;
 use rsruckig::prelude::*;
-use snapgen_model::online::position::Branch;
-use snapgen_model::online::{
+use snapgen_model::{ChainState, Format, Program, Quantity};
+use snapgen_plan::online::position::Branch;
+use snapgen_plan::online::{
     plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlinePlan, OnlineTarget,
 };
-use snapgen_model::{ChainState, Format, Program, Quantity};
 
 /// Per-tick facts of a trace stepped here.
 struct Stepped {

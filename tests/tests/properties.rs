@@ -6,7 +6,8 @@ mod util;
 
 use ethnum::I256;
 use proptest::prelude::*;
-use snapgen_model::{plan, Format, Method, MoveRequest, Plan, Program, Quantity, DEFAULT_FORMAT};
+use snapgen_model::{Format, Program, Quantity, DEFAULT_FORMAT};
+use snapgen_plan::{plan, Method, MoveRequest, Plan};
 use util::{assert_plan_promises, integrated, is_range_error, peak, traced};
 
 /// A log-uniform value in `[lo, hi]`.

@@ -2,10 +2,11 @@
 //! accepted. Raise the case count with `PROPTEST_CASES`.
 
 use proptest::prelude::*;
-use snapgen_model::protocol::{
-    crc16, Command, Decoded, Decoder, Frame, Reply, COMMANDS, DEVICE_MAX_PAYLOAD, START,
+use snapgen_host::protocol::{
+    crc16, Command, Decoded, Decoder, Frame, Reply, DEVICE_MAX_PAYLOAD, START,
 };
 use snapgen_model::DEFAULT_FORMAT;
+use snapgen_spec::COMMANDS;
 
 fn frame() -> impl Strategy<Value = Frame> {
     (
@@ -98,7 +99,7 @@ fn corrupted_length_bytes_are_rejected() {
         Command::Start.to_frame(2, f),
         Command::Commit { count: 15 }.to_frame(3, f),
         Command::Configure {
-            param: snapgen_model::protocol::Param::StopJerk,
+            param: snapgen_host::protocol::Param::StopJerk,
             value: 12_345,
         }
         .to_frame(5, f),
@@ -182,7 +183,7 @@ proptest! {
                 peer.observe(&o);
                 for b in peer.take_received() {
                     if let Some(Decoded::Frame(f)) = decoder.push(b) {
-                        if f.cmd != snapgen_model::protocol::code::TELEMETRY {
+                        if f.cmd != snapgen_host::protocol::code::TELEMETRY {
                             replies.push(f);
                         }
                     }
@@ -195,7 +196,8 @@ proptest! {
             prop_assert!(reply.is_some(), "{:?}", r);
             // A refusal is one the refusal table (docs/PROTOCOL.md) lists for its command.
             if let Some(Reply::Nak { cmd, reason }) = reply {
-                use snapgen_model::protocol::{refusal_documented, Reason};
+                use snapgen_host::protocol::Reason;
+                use snapgen_spec::refusals::refusal_documented;
                 let frame_level = matches!(
                     reason,
                     Reason::BadCrc | Reason::Framing | Reason::BadLength | Reason::UnknownCommand

@@ -15,7 +15,8 @@ mod util;
 
 use proptest::prelude::*;
 use snapgen_model::stop::{StopLaw, StopLimits};
-use snapgen_model::{plan, ChainState, Format, Method, MoveRequest, Quantity};
+use snapgen_model::{ChainState, Format, Quantity};
+use snapgen_plan::{plan, Method, MoveRequest};
 
 /// Plays the law on a chain stepped here, from `s` (the registers after a tick), for at most
 /// `max` ticks; returns every tick's registers and the law.

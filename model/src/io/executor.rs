@@ -22,11 +22,26 @@
 //! moves, POWER 0 and the parameters settable only at rest are refused (BUSY) whatever the
 //! state.
 
-use crate::core::BANK_DEPTH;
-use crate::protocol::{
-    code, command_spec, AxisState, ErrorId, Param, Reason, Settable, REPLY_QUEUE,
+use snapgen_spec::codes::command_spec;
+use snapgen_spec::fields::{
+    Field, COMMIT_FIELDS, CONFIG_FIELDS, LOAD_SEGMENT_FIELDS, POWER_FIELDS, SWAP_AT_FIELDS,
 };
-use crate::stop::StopLimits;
+use snapgen_spec::rules::{REPLY_QUEUE, SWAP_MIN_LEAD, SWAP_REACH};
+use snapgen_spec::widths::{ADDR_BITS, INDEX_BITS, MAX_SEGMENTS};
+use snapgen_spec::{code, AxisState, ErrorId, Param, Reason, Settable};
+
+pub use crate::io::config::Config;
+use crate::ports::{CoreCommand, CoreStatus};
+
+/// The payload fields the executor reads, by name from the layouts.
+const SEG_INDEX: Field = snapgen_spec::fields::field(&LOAD_SEGMENT_FIELDS, "index");
+const SEG_TICKS: Field = snapgen_spec::fields::field(&LOAD_SEGMENT_FIELDS, "ticks");
+const SEG_SNAP: Field = snapgen_spec::fields::field(&LOAD_SEGMENT_FIELDS, "snap");
+const COMMIT_COUNT: Field = snapgen_spec::fields::field(&COMMIT_FIELDS, "count");
+const CFG_PARAM: Field = snapgen_spec::fields::field(&CONFIG_FIELDS, "param");
+const CFG_VALUE: Field = snapgen_spec::fields::field(&CONFIG_FIELDS, "value");
+const POWER_ON: Field = snapgen_spec::fields::field(&POWER_FIELDS, "on");
+const SWAP_TICK: Field = snapgen_spec::fields::field(&SWAP_AT_FIELDS, "tick");
 
 /// What a queued reply is; the payload is read when the reply is sent.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -77,121 +92,6 @@ pub struct ReplyDesc {
     pub aux: u8,
 }
 
-/// The configuration registers.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Config {
-    /// Clocks per tick − 1.
-    pub tick_div: u32,
-    /// PWM period (clocks).
-    pub pwm_period: u16,
-    /// Encoder filter (clocks).
-    pub encoder_filter: u16,
-    /// Telemetry period (ticks).
-    pub telemetry_period: u32,
-    /// The stop's limits.
-    pub stop: StopLimits,
-    /// Watchdog (ms).
-    pub watchdog_ms: u32,
-    /// Input polarity bits.
-    pub input_polarity: u8,
-    /// Input filter (clocks).
-    pub input_filter: u16,
-    /// The position controller's configuration.
-    pub servo: crate::io::servo::ServoConfig,
-}
-
-impl Config {
-    /// After reset: the generated tick divider and input polarity, the watchdog's default,
-    /// everything else 0.
-    pub fn after_reset(tick_div: u32, input_polarity: u8) -> Self {
-        Config {
-            tick_div,
-            watchdog_ms: crate::protocol::DEFAULT_WATCHDOG_MS,
-            input_polarity,
-            servo: crate::io::servo::ServoConfig {
-                output_limit: i16::MAX as u16,
-                ..Default::default()
-            },
-            ..Default::default()
-        }
-    }
-
-    /// The value of `p`.
-    pub fn get(&self, p: Param) -> i128 {
-        match p {
-            Param::TickDivider => i128::from(self.tick_div),
-            Param::PwmPeriod => i128::from(self.pwm_period),
-            Param::EncoderFilter => i128::from(self.encoder_filter),
-            Param::TelemetryPeriod => i128::from(self.telemetry_period),
-            Param::StopJerk => self.stop.jerk,
-            Param::StopAccel => self.stop.accel,
-            Param::WatchdogMs => i128::from(self.watchdog_ms),
-            Param::InputPolarity => i128::from(self.input_polarity),
-            Param::InputFilter => i128::from(self.input_filter),
-            Param::ServoPeriod => i128::from(self.servo.period),
-            Param::Kp => i128::from(self.servo.kp),
-            Param::Ki => i128::from(self.servo.ki),
-            Param::Kd => i128::from(self.servo.kd),
-            Param::Kv => i128::from(self.servo.kv),
-            Param::Ka => i128::from(self.servo.ka),
-            Param::IntegralLimit => i128::from(self.servo.integral_limit),
-            Param::OutputLimit => i128::from(self.servo.output_limit),
-            Param::FollowingLimit => i128::from(self.servo.following_limit),
-            Param::DFilter => i128::from(self.servo.d_filter),
-        }
-    }
-
-    /// The position controller's parameters: the two set only while Disabled first.
-    pub const SERVO_PARAMS: [Param; 10] = [
-        Param::ServoPeriod,
-        Param::FollowingLimit,
-        Param::Kp,
-        Param::Ki,
-        Param::Kd,
-        Param::Kv,
-        Param::Ka,
-        Param::IntegralLimit,
-        Param::OutputLimit,
-        Param::DFilter,
-    ];
-
-    /// What CONFIGURE writes for the controller configuration `servo`, in
-    /// [`Self::SERVO_PARAMS`]' order (through [`Self::get`]: one mapping of fields to
-    /// parameters for the device and for every host).
-    pub fn servo_writes(servo: &crate::io::servo::ServoConfig) -> [(Param, i128); 10] {
-        let c = Config {
-            servo: *servo,
-            ..Default::default()
-        };
-        Self::SERVO_PARAMS.map(|p| (p, c.get(p)))
-    }
-
-    /// Sets `p` to `v` (in range: CONFIGURE checks it).
-    pub fn set(&mut self, p: Param, v: i128) {
-        match p {
-            Param::TickDivider => self.tick_div = v as u32,
-            Param::PwmPeriod => self.pwm_period = v as u16,
-            Param::EncoderFilter => self.encoder_filter = v as u16,
-            Param::TelemetryPeriod => self.telemetry_period = v as u32,
-            Param::StopJerk => self.stop.jerk = v,
-            Param::StopAccel => self.stop.accel = v,
-            Param::WatchdogMs => self.watchdog_ms = v as u32,
-            Param::InputPolarity => self.input_polarity = v as u8,
-            Param::InputFilter => self.input_filter = v as u16,
-            Param::ServoPeriod => self.servo.period = v as u16,
-            Param::Kp => self.servo.kp = v as i64,
-            Param::Ki => self.servo.ki = v as i64,
-            Param::Kd => self.servo.kd = v as i64,
-            Param::Kv => self.servo.kv = v as i64,
-            Param::Ka => self.servo.ka = v as i64,
-            Param::IntegralLimit => self.servo.integral_limit = v as i64,
-            Param::OutputLimit => self.servo.output_limit = v as u16,
-            Param::FollowingLimit => self.servo.following_limit = v as u32,
-            Param::DFilter => self.servo.d_filter = v as u8,
-        }
-    }
-}
-
 /// Inputs of one clock (every one a registered output of another block).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExecutorInputs {
@@ -201,67 +101,29 @@ pub struct ExecutorInputs {
     pub rx: crate::io::frame_rx::FrameRxOutputs,
     /// UART framing error.
     pub line_error: bool,
-    /// Core: a program plays.
-    pub busy: bool,
-    /// Core: a controlled stop runs.
-    pub stopping: bool,
-    /// Core: the standby program's segment count.
-    pub standby_count: u8,
-    /// Core: the tick enable.
-    pub tick: bool,
-    /// Core: the chain is at rest (v = a = j = 0).
-    pub at_rest: bool,
-    /// Core: the axis heads forward.
-    pub heading_positive: bool,
-    /// Core: the axis heads backward.
-    pub heading_negative: bool,
+    /// The core's status outputs.
+    pub core: CoreStatus,
     /// The encoder's count of illegal transitions.
     pub encoder_errors: u16,
     /// The reply queue is full.
     pub queue_full: bool,
     /// Positive limit input (filtered, polarity applied).
-    pub limit_positive: bool,
+    pub limit_pos: bool,
     /// Negative limit input.
-    pub limit_negative: bool,
+    pub limit_neg: bool,
     /// Emergency-stop input.
-    pub emergency_stop: bool,
+    pub estop: bool,
     /// The controller: the following error is beyond its limit.
     pub following_fault: bool,
     /// The controller skipped a sample.
     pub servo_overrun: bool,
-    /// Core: the time base (ticks since reset).
-    pub ticks: u64,
-    /// Core: a program swap is armed.
-    pub swap_pending: bool,
 }
 
 /// Outputs after a clock edge.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExecutorOutputs {
-    /// Core: write one segment.
-    pub write_enable: bool,
-    /// Core: segment address.
-    pub write_address: u8,
-    /// Core: segment ticks.
-    pub write_ticks: u32,
-    /// Core: segment snap.
-    pub write_snap: i128,
-    /// Core: set the count.
-    pub count_enable: bool,
-    /// Core: count.
-    pub count_value: u8,
-    /// Core: start.
-    pub start: bool,
-    /// Core: arm a program swap for the tick after `swap_last`.
-    pub swap: bool,
-    /// Core: the low 32 bits of the swap's tick minus one (held until the next SWAP_AT).
-    pub swap_last: u32,
-    /// Core: controlled stop.
-    pub stop: bool,
-    /// Core: abort (emergency stop, following error).
-    pub abort: bool,
-    /// Core: the reference takes the encoder's position, at rest (POWER 1 from Disabled).
-    pub load: bool,
+    /// The core's command inputs (pulses last one clock).
+    pub command: CoreCommand,
     /// The configuration.
     pub config: Config,
     /// The axis state.
@@ -334,13 +196,16 @@ impl Executor {
     pub fn clock(&mut self, i: &ExecutorInputs) -> ExecutorOutputs {
         let before = self.out;
         // Pulses last one clock.
-        self.out.write_enable = false;
-        self.out.count_enable = false;
-        self.out.start = false;
-        self.out.swap = false;
-        self.out.stop = false;
-        self.out.abort = false;
-        self.out.load = false;
+        // Pulses last one clock; the values they carry are held (the core reads them with
+        // their pulse only).
+        let c = &mut self.out.command;
+        c.write_enable = false;
+        c.count_enable = false;
+        c.start = false;
+        c.swap = false;
+        c.stop = false;
+        c.abort_move = false;
+        c.load = false;
         self.out.reply = None;
         self.out.telemetry = false;
         if i.reset {
@@ -363,10 +228,10 @@ impl Executor {
         // Telemetry while the chain is driven, and once when it stops being driven, from the
         // period and countdown before this clock (a CONFIGURE of the period, below, restarts
         // the countdown and takes effect from the next clock).
-        let driven = i.busy || i.stopping;
+        let driven = i.core.busy || i.core.stopping;
         let period = cfg.telemetry_period;
         if period != 0 {
-            if i.tick && driven {
+            if i.core.tick && driven {
                 if self.telemetry_left <= 1 {
                     self.out.telemetry = true;
                     self.telemetry_left = period;
@@ -416,65 +281,63 @@ impl Executor {
         // ended moving: a controlled stop into ErrorStop), then the errors (the emergency stop
         // last: it overrides everything).
         // (A swap armed while the axis rests is a start still to come.)
-        let settling = before.start || before.stop || before.swap;
+        let settling = before.command.start || before.command.stop || before.command.swap;
         if matches!(
             o.state,
             AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::Stopping
         ) && s == o.state
-            && !i.busy
-            && !i.stopping
+            && !i.core.busy
+            && !i.core.stopping
             && !settling
-            && (!i.at_rest || !i.swap_pending)
+            && (!i.core.at_rest || !i.core.swap_pending)
         {
-            if i.at_rest {
+            if i.core.at_rest {
                 o.state = AxisState::Standstill;
             } else {
-                o.stop = true;
+                o.command.stop = true;
                 o.state = AxisState::ErrorStop;
                 o.error = ErrorId::ProgramEnd;
             }
         }
         if expired && matches!(s, AxisState::DiscreteMotion | AxisState::ContinuousMotion) {
-            o.stop = true;
+            o.command.stop = true;
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::Watchdog;
         }
         if s != AxisState::ErrorStop && s != AxisState::Disabled {
-            let toward = if i.limit_positive && i.heading_positive {
+            let toward = if i.limit_pos && i.core.heading_pos {
                 Some(ErrorId::LimitPositive)
-            } else if i.limit_negative && i.heading_negative {
+            } else if i.limit_neg && i.core.heading_neg {
                 Some(ErrorId::LimitNegative)
             } else {
                 None
             };
             if let Some(e) = toward {
-                o.stop = true;
+                o.command.stop = true;
                 o.state = AxisState::ErrorStop;
                 o.error = e;
             }
         }
         if i.following_fault && o.amplifier {
-            o.abort = true;
-            o.stop = false;
-            o.start = false;
-            o.swap = false;
+            o.command.abort_move = true;
+            o.command.stop = false;
+            o.command.start = false;
+            o.command.swap = false;
             o.amplifier = false;
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::FollowingError;
         }
-        if i.emergency_stop
-            && !(s == AxisState::ErrorStop && before.error == ErrorId::EmergencyStop)
-        {
-            o.abort = true;
-            o.stop = false;
-            o.start = false;
-            o.swap = false;
+        if i.estop && !(s == AxisState::ErrorStop && before.error == ErrorId::EmergencyStop) {
+            o.command.abort_move = true;
+            o.command.stop = false;
+            o.command.start = false;
+            o.command.swap = false;
             o.amplifier = false;
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::EmergencyStop;
         }
 
-        self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.ticks);
+        self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.core.ticks);
         self.out
     }
 
@@ -532,7 +395,7 @@ impl Executor {
                 code::PING => data(ReplyKind::Identity, c, seq, 0),
                 code::READ_STATUS => data(ReplyKind::Status, c, seq, 0),
                 code::READ_STATE => data(ReplyKind::State, c, seq, 0),
-                code::READ_CONFIG => data(ReplyKind::Config, c, seq, rx.byte(0)),
+                code::READ_CONFIG => data(ReplyKind::Config, c, seq, rx.get(&CFG_PARAM) as u8),
                 _ => {
                     self.effect(i, s);
                     ack
@@ -548,26 +411,29 @@ impl Executor {
     /// Arguments and axis state: why the command is refused, if it is.
     fn check(&self, i: &ExecutorInputs, s: AxisState, cfg: Config) -> Result<(), Reason> {
         let rx = &i.rx;
-        let arg0 = rx.byte(0);
-        let moving = i.busy || i.stopping || !i.at_rest;
-        let toward_limit = (self.first_direction > 0 && i.limit_positive)
-            || (self.first_direction < 0 && i.limit_negative);
+        let moving = i.core.busy || i.core.stopping || !i.core.at_rest;
+        let toward_limit =
+            (self.first_direction > 0 && i.limit_pos) || (self.first_direction < 0 && i.limit_neg);
         let refuse = match rx.cmd {
-            code::LOAD_SEGMENT if usize::from(arg0) >= BANK_DEPTH || rx.field(1, 4) == 0 => {
+            code::LOAD_SEGMENT
+                if rx.get(&SEG_INDEX) >= i128::from(MAX_SEGMENTS) || rx.get(&SEG_TICKS) == 0 =>
+            {
                 Some(Reason::BadArgument)
             }
-            code::COMMIT if usize::from(arg0) > BANK_DEPTH => Some(Reason::BadArgument),
-            code::LOAD_SEGMENT | code::COMMIT if i.swap_pending => Some(Reason::SwapPending),
+            code::COMMIT if rx.get(&COMMIT_COUNT) > i128::from(MAX_SEGMENTS) => {
+                Some(Reason::BadArgument)
+            }
+            code::LOAD_SEGMENT | code::COMMIT if i.core.swap_pending => Some(Reason::SwapPending),
             code::SWAP_AT if self.swap_lead as i64 >= SWAP_REACH => Some(Reason::BadArgument),
             code::START => match s {
                 AxisState::Disabled => Some(Reason::NotEnabled),
                 AxisState::ErrorStop => Some(Reason::AxisError),
                 AxisState::Stopping => Some(Reason::Stopping),
-                _ if i.busy => Some(Reason::Busy),
-                _ if i.stopping => Some(Reason::Stopping),
-                _ if i.swap_pending => Some(Reason::SwapPending),
-                _ if i.standby_count == 0 => Some(Reason::NoProgram),
-                _ if !i.at_rest => Some(Reason::Busy),
+                _ if i.core.busy => Some(Reason::Busy),
+                _ if i.core.stopping => Some(Reason::Stopping),
+                _ if i.core.swap_pending => Some(Reason::SwapPending),
+                _ if i.core.standby_count == 0 => Some(Reason::NoProgram),
+                _ if !i.core.at_rest => Some(Reason::Busy),
                 _ if toward_limit => Some(Reason::Limit),
                 _ => None,
             },
@@ -575,13 +441,13 @@ impl Executor {
                 AxisState::Disabled => Some(Reason::NotEnabled),
                 AxisState::ErrorStop => Some(Reason::AxisError),
                 AxisState::Stopping => Some(Reason::Stopping),
-                _ if i.stopping => Some(Reason::Stopping),
-                _ if i.swap_pending => Some(Reason::SwapPending),
-                _ if i.standby_count == 0 => Some(Reason::NoProgram),
+                _ if i.core.stopping => Some(Reason::Stopping),
+                _ if i.core.swap_pending => Some(Reason::SwapPending),
+                _ if i.core.standby_count == 0 => Some(Reason::NoProgram),
                 // The lead is one clock old and the core arms one clock later: the time base
                 // may have ticked twice by then, and the core wants three ticks of lead.
                 _ if (self.swap_lead as i64) < SWAP_MIN_LEAD => Some(Reason::Late),
-                _ if i.at_rest && !i.busy && toward_limit => Some(Reason::Limit),
+                _ if i.core.at_rest && !i.core.busy && toward_limit => Some(Reason::Limit),
                 _ => None,
             },
             code::STOP if s == AxisState::Disabled => Some(Reason::NotEnabled),
@@ -592,8 +458,8 @@ impl Executor {
                 _ => None,
             },
             code::CONFIGURE => {
-                let value = signed_wide(rx.field(1, 13));
-                match Param::from_byte(arg0) {
+                let value = rx.get(&CFG_VALUE);
+                match Param::from_byte(rx.get(&CFG_PARAM) as u8) {
                     None => Some(Reason::BadArgument),
                     Some(p) if value < 0 || value > p.max() => Some(Reason::BadArgument),
                     Some(p) => match p.settable() {
@@ -606,20 +472,22 @@ impl Executor {
                     },
                 }
             }
-            code::READ_CONFIG if Param::from_byte(arg0).is_none() => Some(Reason::BadArgument),
-            code::POWER => match arg0 {
+            code::READ_CONFIG if Param::from_byte(rx.get(&CFG_PARAM) as u8).is_none() => {
+                Some(Reason::BadArgument)
+            }
+            code::POWER => match rx.get(&POWER_ON) {
                 2.. => Some(Reason::BadArgument),
                 1 if s == AxisState::ErrorStop => Some(Reason::AxisError),
                 1 if s == AxisState::Disabled
-                    && (!cfg.stop.valid()
-                        || (cfg.servo.period != 0 && cfg.servo.following_limit == 0)) =>
+                    && (!cfg.stop_limits().valid()
+                        || (cfg.servo_period != 0 && cfg.following_limit == 0)) =>
                 {
                     Some(Reason::NotConfigured)
                 }
                 0 if moving => Some(Reason::Busy),
                 _ => None,
             },
-            code::RESET if s == AxisState::ErrorStop && (moving || i.emergency_stop) => {
+            code::RESET if s == AxisState::ErrorStop && (moving || i.estop) => {
                 Some(Reason::AxisError)
             }
             _ => None,
@@ -633,51 +501,53 @@ impl Executor {
         let o = &mut self.out;
         match rx.cmd {
             code::LOAD_SEGMENT => {
-                o.write_enable = true;
-                o.write_address = rx.byte(0) & 0x1f;
-                o.write_ticks = rx.field(1, 4) as u32;
-                o.write_snap = signed_wide(rx.field(5, 13));
-                if o.write_address == 0 {
-                    self.first_direction = o.write_snap.signum() as i8;
+                let c = &mut o.command;
+                c.write_enable = true;
+                // The address is the index's low bits (the index was checked).
+                c.write_address = (rx.get(&SEG_INDEX) as u8) & ((1 << ADDR_BITS) - 1);
+                c.write_ticks = rx.get(&SEG_TICKS) as u32;
+                c.write_snap = rx.get(&SEG_SNAP);
+                if c.write_address == 0 {
+                    self.first_direction = c.write_snap.signum() as i8;
                 }
             }
             code::COMMIT => {
-                o.count_enable = true;
-                o.count_value = rx.byte(0) & 0x3f;
+                o.command.count_enable = true;
+                o.command.count_value = (rx.get(&COMMIT_COUNT) as u8) & ((1 << INDEX_BITS) - 1);
             }
             code::START => {
-                o.start = true;
+                o.command.start = true;
                 o.state = AxisState::DiscreteMotion;
                 // The banks swap: the new standby program is empty.
                 self.first_direction = 0;
             }
             code::SWAP_AT => {
-                o.swap = true;
-                o.swap_last = (rx.field(0, 8) as u64).wrapping_sub(1) as u32;
+                o.command.swap = true;
+                o.command.swap_last = (rx.get(&SWAP_TICK) as u64).wrapping_sub(1) as u32;
                 o.state = AxisState::DiscreteMotion;
                 // The banks swap at the tick; no upload is taken before that.
                 self.first_direction = 0;
             }
             code::STOP if s != AxisState::ErrorStop => {
-                o.stop = true;
+                o.command.stop = true;
                 o.state = AxisState::Stopping;
             }
             code::HALT if matches!(s, AxisState::DiscreteMotion | AxisState::ContinuousMotion) => {
-                o.stop = true;
+                o.command.stop = true;
             }
             code::CONFIGURE => {
-                let p = Param::from_byte(rx.byte(0)).expect("checked");
-                o.config.set(p, signed_wide(rx.field(1, 13)));
+                let p = Param::from_byte(rx.get(&CFG_PARAM) as u8).expect("checked");
+                o.config.set(p, rx.get(&CFG_VALUE));
                 if p == Param::TelemetryPeriod {
                     self.telemetry_left = o.config.telemetry_period;
                 }
             }
-            code::POWER => match (rx.byte(0) == 1, s) {
+            code::POWER => match (rx.get(&POWER_ON) == 1, s) {
                 (true, AxisState::Disabled) => {
                     o.amplifier = true;
                     o.state = AxisState::Standstill;
                     // MC_Power: the axis holds where it is.
-                    o.load = true;
+                    o.command.load = true;
                 }
                 (true, _) => {}
                 (false, st) => {
@@ -707,36 +577,22 @@ impl Executor {
     }
 }
 
-/// How far ahead of the time base a SWAP_AT may lie: the core compares the low 32 bits.
-pub const SWAP_REACH: i64 = 1 << 31;
-
-/// The least lead a SWAP_AT is accepted with, over the time base on the clock before the one
-/// that executes it (docs/PROTOCOL.md, "Program swaps").
-pub const SWAP_MIN_LEAD: i64 = 5;
-
-/// SWAP_AT's `tick`, read from the received payload as if it were an 8-byte one (the last 8
-/// bytes received), as the fabric wires it.
+/// SWAP_AT's `tick`, read from the received payload as if it were SWAP_AT's (the last bytes
+/// received), as the fabric wires it.
 fn swap_tick_field(rx: &crate::io::frame_rx::FrameRxOutputs) -> u64 {
-    (0..8).fold(0u64, |acc, k| {
-        acc | (u64::from(rx.payload[7 - k]) << (8 * k))
-    })
+    rx.get_as(&SWAP_TICK, snapgen_spec::fields::SwapAtArgs::BYTES) as u64
 }
 
 /// False when setting `p` to `value` would leave the stop limits unusable
 /// (`0 < jerk ≤ accel` fails): refused while the axis is enabled.
 fn stop_pair_valid(cfg: Config, p: Param, value: i128) -> bool {
-    let mut limits = cfg.stop;
+    let mut limits = cfg.stop_limits();
     match p {
         Param::StopJerk => limits.jerk = value,
         Param::StopAccel => limits.accel = value,
         _ => return true,
     }
     limits.valid()
-}
-
-/// A 104-bit two's-complement value (13 bytes) as i128.
-pub fn signed_wide(raw: u128) -> i128 {
-    crate::chain::wrap(raw as i128, 104)
 }
 
 fn nak(cmd: u8, seq: u8, reason: Reason) -> ReplyDesc {
@@ -795,39 +651,5 @@ impl ReplyQueue {
                 self.items.push_back(r);
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::servo::ServoConfig;
-
-    /// What a host writes for a controller configuration, replayed through CONFIGURE's
-    /// setter, is that configuration: every field has its parameter, and only one.
-    #[test]
-    fn servo_writes_round_trip_through_configure() {
-        let want = ServoConfig {
-            period: 3,
-            kp: 11,
-            ki: 12,
-            kd: 13,
-            kv: 14,
-            ka: 15,
-            integral_limit: 16,
-            output_limit: 17,
-            following_limit: 18,
-            d_filter: 4,
-        };
-        let mut c = Config::default();
-        let writes = Config::servo_writes(&want);
-        for (p, v) in writes {
-            c.set(p, v);
-        }
-        assert_eq!(c.servo, want);
-        let mut params: Vec<u8> = writes.iter().map(|(p, _)| *p as u8).collect();
-        params.sort_unstable();
-        params.dedup();
-        assert_eq!(params.len(), writes.len());
     }
 }

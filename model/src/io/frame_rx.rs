@@ -4,9 +4,10 @@
 //! `frame` or `bad_crc` one clock after the last CRC byte, with the command, sequence, length,
 //! the payload (byte `k` of `n` at bits `8(n−1−k)..`) and the received CRC. A frame cut short
 //! by an inter-byte gap of `timeout` clocks, or by a UART framing error, is dropped with a
-//! `dropped` pulse. At the byte level it decodes as [`crate::protocol::Decoder::device`].
+//! `dropped` pulse. At the byte level it decodes as the host's `Decoder::device` (`snapgen_host::protocol`).
 
-use crate::protocol::{crc16_step, CRC_INIT, DEVICE_MAX_PAYLOAD, START};
+use snapgen_spec::fields::Field;
+use snapgen_spec::wire::{crc16_step, CRC_INIT, DEVICE_MAX_PAYLOAD, START};
 
 /// The receiver's states.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -69,11 +70,19 @@ impl FrameRxOutputs {
         }
     }
 
-    /// Little-endian field of `bytes` bytes at payload byte `at`, as u128.
-    pub fn field(&self, at: usize, bytes: usize) -> u128 {
-        (0..bytes).fold(0u128, |acc, i| {
-            acc | (u128::from(self.byte(at + i)) << (8 * i))
-        })
+    /// Field `f` of the last frame's payload (sign-extended when the field is signed).
+    pub fn get(&self, f: &Field) -> i128 {
+        self.get_as(f, usize::from(self.len))
+    }
+
+    /// Field `f` of the last `len` payload bytes received, whatever the frame's length (how
+    /// the fabric wires a field it reads before the length is checked).
+    pub fn get_as(&self, f: &Field, len: usize) -> i128 {
+        let mut bytes = [0u8; 32];
+        for (k, b) in bytes.iter_mut().enumerate().take(len.min(32)) {
+            *b = self.payload[len - 1 - k];
+        }
+        snapgen_spec::fields::get(&bytes, f)
     }
 }
 
@@ -199,60 +208,6 @@ impl FrameRx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::DEFAULT_FORMAT;
-    use crate::protocol::{Command, Decoded, Decoder, Param};
-    use proptest::prelude::*;
-
-    /// Byte by byte (one a clock, with gaps shorter than the timeout), the receiver finds the
-    /// frames the device decoder finds, with the same command, sequence and payload.
-    fn feed(bytes: &[u8]) -> Vec<Decoded> {
-        let mut rx = FrameRx::new();
-        let mut out = Vec::new();
-        let got = |o: FrameRxOutputs, out: &mut Vec<Decoded>| {
-            if o.frame {
-                out.push(Decoded::Frame(crate::protocol::Frame {
-                    cmd: o.cmd,
-                    seq: o.seq,
-                    payload: (0..usize::from(o.len)).map(|k| o.byte(k)).collect(),
-                }));
-            }
-            if o.bad_crc {
-                out.push(Decoded::BadCrc);
-            }
-        };
-        for &b in bytes {
-            let o = rx.clock(&FrameRxInputs {
-                data: b,
-                valid: true,
-                timeout: 100,
-                ..Default::default()
-            });
-            got(o, &mut out);
-            let o = rx.clock(&FrameRxInputs {
-                timeout: 100,
-                ..Default::default()
-            });
-            got(o, &mut out);
-        }
-        out
-    }
-
-    proptest! {
-        #[test]
-        fn decodes_as_the_device_decoder(bytes in proptest::collection::vec(any::<u8>(), 0..300), frames in 0usize..4, seed in any::<u64>()) {
-            let f = DEFAULT_FORMAT;
-            let mut stream = bytes;
-            for k in 0..frames {
-                let c = Command::Configure { param: Param::WatchdogMs, value: i128::from(seed as u16) + k as i128 };
-                let at = (seed as usize + 7 * k) % (stream.len() + 1);
-                let frame = c.to_frame(k as u8, &f).to_bytes();
-                stream.splice(at..at, frame);
-            }
-            let mut d = Decoder::device();
-            let want: Vec<Decoded> = stream.iter().filter_map(|&b| d.push(b)).collect();
-            prop_assert_eq!(feed(&stream), want);
-        }
-    }
 
     #[test]
     fn a_gap_drops_a_partial_frame() {

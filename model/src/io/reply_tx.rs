@@ -5,8 +5,11 @@
 //! then high — into the transmit FIFO one byte per clock while the FIFO is not full. Frames are
 //! never interleaved; telemetry waits while a reply is queued.
 
+use snapgen_spec::fields::{AckPayload, ConfigValue, Identity, NakPayload, StateReply, Status};
+use snapgen_spec::wire::{crc16_step, CRC_INIT, START};
+use snapgen_spec::{code, flag, Param};
+
 use crate::io::executor::{Config, ReplyDesc, ReplyKind};
-use crate::protocol::{crc16_step, Identity, Param, Reply, StateReply, Status, CRC_INIT, START};
 
 /// What the payloads are read from (the live values of the clock a reply starts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -23,30 +26,42 @@ pub struct Live {
 }
 
 impl Live {
-    /// The reply `d` stands for.
-    pub fn reply(&self, d: &ReplyDesc) -> Reply {
+    /// The code and payload of the reply `d` stands for.
+    pub fn reply(&self, d: &ReplyDesc) -> (u8, Vec<u8>) {
         match d.kind {
-            ReplyKind::Identity => Reply::Identity(Identity {
-                tick_divider: self.config.tick_div,
-                stop: self.config.stop,
-                ..self.identity
-            }),
-            ReplyKind::Ack => Reply::Ack { cmd: d.cmd },
-            ReplyKind::Nak => Reply::Nak {
-                cmd: d.cmd,
-                reason: crate::protocol::Reason::from_byte(d.aux)
-                    .expect("the executor queues known reasons"),
-            },
-            ReplyKind::Status => Reply::Status(self.status),
-            ReplyKind::State => Reply::State(self.state),
+            ReplyKind::Identity => (
+                code::IDENTITY,
+                Identity {
+                    tick_divider: self.config.tick_divider,
+                    stop_jerk: self.config.stop_jerk,
+                    stop_accel: self.config.stop_accel,
+                    ..self.identity
+                }
+                .to_payload(),
+            ),
+            ReplyKind::Ack => (code::ACK, AckPayload { cmd: d.cmd }.to_payload()),
+            ReplyKind::Nak => (
+                code::NAK,
+                NakPayload {
+                    cmd: d.cmd,
+                    reason: d.aux,
+                }
+                .to_payload(),
+            ),
+            ReplyKind::Status => (code::STATUS, self.status.to_payload()),
+            ReplyKind::State => (code::STATE, self.state.to_payload()),
             ReplyKind::Config => {
                 let param = Param::from_byte(d.aux).expect("the executor checked it");
-                Reply::Config {
-                    param,
-                    value: self.config.get(param),
-                }
+                (
+                    code::CONFIG,
+                    ConfigValue {
+                        param: d.aux,
+                        value: self.config.get(param),
+                    }
+                    .to_payload(),
+                )
             }
-            ReplyKind::Telemetry => Reply::Telemetry(self.status),
+            ReplyKind::Telemetry => (code::TELEMETRY, self.status.to_payload()),
         }
     }
 }
@@ -143,13 +158,13 @@ impl ReplyTx {
                 None => None,
             };
             if let Some(d) = d {
-                let frame = live.reply(&d).to_frame(d.seq);
+                let (code, payload) = live.reply(&d);
                 self.active = true;
                 self.index = 0;
-                self.len = frame.payload.len() as u8;
-                self.code = frame.cmd;
-                self.seq = frame.seq;
-                self.payload = frame.payload;
+                self.len = payload.len() as u8;
+                self.code = code;
+                self.seq = d.seq;
+                self.payload = payload;
                 self.crc = CRC_INIT;
             }
         } else if out.fifo_write {
@@ -186,18 +201,17 @@ pub struct StatusInputs<'a> {
     /// An illegal encoder transition was seen.
     pub encoder_error: bool,
     /// Limit and emergency-stop inputs (filtered, polarity applied).
-    pub limit_positive: bool,
+    pub limit_pos: bool,
     /// Negative limit.
-    pub limit_negative: bool,
+    pub limit_neg: bool,
     /// Emergency stop.
-    pub emergency_stop: bool,
+    pub estop: bool,
     /// The controller's outputs.
     pub servo: &'a crate::io::servo::ServoOutputs,
 }
 
 /// The status block.
 pub fn status(s: &StatusInputs) -> Status {
-    use crate::protocol::flag;
     let (e, c) = (s.exec, s.core);
     let mut flags = 0u16;
     for (on, bit) in [
@@ -207,9 +221,9 @@ pub fn status(s: &StatusInputs) -> Status {
         (c.stopping, flag::STOPPING),
         (c.stop_over, flag::STOP_OVER_LIMITS),
         (e.amplifier, flag::AMPLIFIER),
-        (s.limit_positive, flag::LIMIT_POSITIVE),
-        (s.limit_negative, flag::LIMIT_NEGATIVE),
-        (s.emergency_stop, flag::EMERGENCY_STOP),
+        (s.limit_pos, flag::LIMIT_POSITIVE),
+        (s.limit_neg, flag::LIMIT_NEGATIVE),
+        (s.estop, flag::EMERGENCY_STOP),
         (s.encoder_error, flag::ENCODER_ERROR),
         (e.uart_error, flag::UART_ERROR),
         (e.reply_overflow, flag::REPLY_OVERFLOW),

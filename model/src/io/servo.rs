@@ -45,45 +45,23 @@
 
 use crate::chain::wrap;
 
-/// Fractional bits of the following error below one count.
-pub const E_FRAC: u32 = 16;
+/// Fractional bits of the following error below one count (the status block's unit).
+pub const E_FRAC: u32 = snapgen_spec::widths::E_FRAC;
 /// `vs = v >> V_SHIFT`: velocity in counts per tick with 32 fractional bits.
 pub const V_SHIFT: u32 = 48;
 /// `as = a >> A_SHIFT`: acceleration in counts per tick² with 40 fractional bits.
 pub const A_SHIFT: u32 = 40;
 /// `u = sum >> OUT_SHIFT`, rounded.
 pub const OUT_SHIFT: u32 = 48;
-/// Gains are below `2^GAIN_BITS`.
-pub const GAIN_BITS: u32 = 47;
+/// Gains are below `2^GAIN_BITS` (their registers hold `snapgen_spec::widths::GAIN_BITS`
+/// bits, two's complement).
+pub const GAIN_BITS: u32 = snapgen_spec::widths::GAIN_BITS - 1;
 /// Clocks from a sample to its duty: 1 to check the error and update the integrator, 5 per
 /// term (3 gain digits of 16 bits through a registered multiplier, the last product's
 /// addition, the sum), 1 to round and saturate.
 pub const LATENCY: u32 = 1 + 5 * 5 + 1;
 
-/// The controller's configuration (CONFIGURE).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct ServoConfig {
-    /// Ticks per sample (0: the controller is off, duty 0, no following-error check).
-    pub period: u16,
-    /// Proportional gain, `Kp·2^32` (PWM clocks per count).
-    pub kp: i64,
-    /// Integral gain, `Ki·2^32` (PWM clocks per count·sample).
-    pub ki: i64,
-    /// Derivative gain, `Kd·2^32` (PWM clocks per count/sample).
-    pub kd: i64,
-    /// Velocity feed-forward, `Kv·2^16` (PWM clocks per count/tick).
-    pub kv: i64,
-    /// Acceleration feed-forward, `Ka·2^8` (PWM clocks per count/tick²).
-    pub ka: i64,
-    /// The integrator's limit, `|I| ≤` this (counts·samples·2^16).
-    pub integral_limit: i64,
-    /// The duty's limit, PWM clocks (≤ 32 767).
-    pub output_limit: u16,
-    /// The following-error limit, counts (0 with the controller on: POWER is refused).
-    pub following_limit: u32,
-    /// The derivative filter's shift `k` (0..=15; 0: none).
-    pub d_filter: u8,
-}
+pub use crate::io::config::ServoConfig;
 
 /// The gains and limits in physical units, per the controller's units: PWM clocks (duty),
 /// encoder counts, ticks and samples.
@@ -305,10 +283,10 @@ impl Servo {
         }
         let busy = self.countdown > 0;
         // The divider counts ticks; a sample on the tick it reaches 0.
-        let due = i.tick && c.period != 0 && self.divider == 0;
-        if i.tick && c.period != 0 {
+        let due = i.tick && c.servo_period != 0 && self.divider == 0;
+        if i.tick && c.servo_period != 0 {
             self.divider = if self.divider == 0 {
-                c.period - 1
+                c.servo_period - 1
             } else {
                 self.divider - 1
             };
@@ -349,7 +327,7 @@ mod tests {
 
     fn cfg() -> ServoConfig {
         ServoConfig {
-            period: 1,
+            servo_period: 1,
             kp: 1 << 32,
             output_limit: 1000,
             following_limit: 100,

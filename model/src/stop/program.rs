@@ -523,7 +523,7 @@ mod tests {
     /// Limits a CONFIGURE can set: at most `Param::StopAccel.max()` (103 bits, the engine's
     /// limit inputs), as the executor refuses larger ones.
     fn limits() -> impl Strategy<Value = StopLimits> {
-        let most = crate::protocol::Param::StopAccel.max();
+        let most = snapgen_spec::Param::StopAccel.max();
         (0u32..100, 0u32..100, 1i128..1000, 1i128..1000).prop_map(move |(jb, ab, jm, am)| {
             let jerk = (jm << jb.min(90)).max(1);
             let accel = (am << ab.min(100)).min(most).max(jerk);
@@ -539,7 +539,7 @@ mod tests {
     fn the_engine_stops_as_the_law_at_the_widest_limits() {
         let l = StopLimits {
             jerk: 216_576,
-            accel: crate::protocol::Param::StopAccel.max(),
+            accel: snapgen_spec::Param::StopAccel.max(),
         };
         let s = ChainState {
             x: 0,

@@ -1,7 +1,7 @@
 //! PLCopen event streams on the lockstep core: random scripts of MC_MoveAbsolute (every
 //! buffer mode, blends among them), MC_MoveVelocity, MC_Halt and feed-override changes at
 //! random ticks — mid-jerk, mid-acceleration, at cruise, at rest — played by the host's own
-//! driver (`snapgen_model::axis::driver::run`): it plans every change from the exact state at
+//! driver (`snapgen_host::axis::driver::run`): it plans every change from the exact state at
 //! a swap tick ahead of the link's latency, uploads it, arms the swap and compares every state
 //! it reads with its prediction. The link here is the core's own ports, one clock per segment
 //! written, with the wire time of a UART at the stream's baud rate passing on the core as
@@ -10,13 +10,13 @@
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use snapgen_model::axis::driver::{
+use snapgen_host::axis::driver::{
     run, Action, Event, Link, LinkError, RunError, RunOptions, RunReport,
 };
-use snapgen_model::axis::{AxisSettings, BufferMode, MotionCommand, Outcome};
-use snapgen_model::online::OnlineOrder;
-use snapgen_model::protocol::{Command, Reason, Reply, StateReply};
+use snapgen_host::axis::{AxisSettings, BufferMode, MotionCommand, Outcome};
+use snapgen_host::protocol::{Command, Reason, Reply, StateReply};
 use snapgen_model::{CoreInputs, Format};
+use snapgen_plan::online::OnlineOrder;
 
 use super::{CosimReport, Lockstep, Mismatch, BATCH};
 use crate::moves::{log_uniform, MoveSpec};
@@ -124,7 +124,7 @@ impl Link for CoreLink<'_> {
             Command::Stop => {
                 // Only on a divergence (which fails the stream): abort at once.
                 self.clock(&CoreInputs {
-                    abort: true,
+                    abort_move: true,
                     ..self.idle
                 });
                 let idle = self.idle;
@@ -294,7 +294,7 @@ pub(super) fn stream(
     if !ls_at_rest(link.ls) {
         link.ls.drive(
             &CoreInputs {
-                abort: true,
+                abort_move: true,
                 ..*idle
             },
             1,

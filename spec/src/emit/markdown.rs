@@ -60,10 +60,7 @@ fn row(cells: &[String]) -> String {
 
 fn table(header: &[&str], rows: Vec<Vec<String>>) -> String {
     let mut s = row(&header.iter().map(|h| h.to_string()).collect::<Vec<_>>());
-    s.push_str(&row(&header
-        .iter()
-        .map(|_| "---".to_string())
-        .collect::<Vec<_>>()));
+    s.push_str(&format!("|{}\n", "---|".repeat(header.len())));
     for r in rows {
         s.push_str(&row(&r));
     }
@@ -112,6 +109,9 @@ pub fn block(name: &str, extra: &[(&str, String)]) -> Result<String, DocError> {
             for c in COMMANDS {
                 let payload = if c.fields.is_empty() {
                     "—".to_string()
+                } else if let Some(r) = REPLIES.iter().find(|r| r.fields == c.fields) {
+                    // A layout a reply shares: described below, with the reply.
+                    x(r.meaning)?
                 } else {
                     let mut parts = Vec::new();
                     for f in c.fields {

@@ -2,7 +2,8 @@
 #![allow(dead_code)]
 
 use ethnum::I256;
-use snapgen_model::{Format, Method, Plan, PlanError, Quantity, Trace, FRAC_BITS};
+use snapgen_model::{Format, Quantity, Trace, FRAC_BITS};
+use snapgen_plan::{Method, Plan, PlanError};
 pub use snapgen_verify::{integrate, Integration, State};
 
 /// The case count of a property: `PROPTEST_CASES` when set (as proptest's own default

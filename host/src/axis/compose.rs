@@ -1,10 +1,10 @@
 //! Composing a change: which parts of the timeline keep playing, which are replanned, from
 //! which exact state, and the program the fabric plays from the swap tick.
 
-use crate::chain::ChainState;
-use crate::format::{Format, Quantity};
-use crate::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
-use crate::program::{Program, Segment};
+use snapgen_model::chain::ChainState;
+use snapgen_model::format::{Format, Quantity};
+use snapgen_model::program::{Program, Segment};
+use snapgen_plan::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
 
 use super::{
     scaled, AxisErrorId, BufferMode, Change, Goal, HostAxis, MotionCommand, Outcome, Part, Timeline,
@@ -657,7 +657,7 @@ fn plan_part(
 
 /// The output cell of a position (unit).
 pub fn cell_of(position: f64, f: &Format) -> i128 {
-    crate::planner::fmath::round(position / f.position_lsb) as i128
+    snapgen_plan::planner::fmath::round(position / f.position_lsb) as i128
 }
 
 /// The velocity a move (`dist` cells toward its target `cell`, velocity `v`) passes its
@@ -728,7 +728,7 @@ impl HostAxis {
 mod tests {
     use super::*;
     use crate::axis::AxisSettings;
-    use crate::DEFAULT_FORMAT;
+    use snapgen_model::DEFAULT_FORMAT;
 
     fn mv(position: f64, velocity: f64) -> MotionCommand {
         MotionCommand::MoveAbsolute {

@@ -10,12 +10,12 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::chain::ChainState;
 use crate::protocol::{Command, Reason, Reply, StateReply};
+use snapgen_model::chain::ChainState;
 
 use super::compose::{Refusal, Request};
 use super::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
-use crate::program::Program;
+use snapgen_model::program::Program;
 
 /// A board the host talks to.
 pub trait Link {
@@ -186,7 +186,7 @@ fn too_slow() -> RunError {
 const SAFETY: u64 = 20;
 
 /// Bytes of `c`'s frame.
-fn frame_bytes(c: &Command, f: &crate::format::Format) -> usize {
+fn frame_bytes(c: &Command, f: &snapgen_model::format::Format) -> usize {
     c.to_frame(0, f).to_bytes().len()
 }
 
@@ -204,12 +204,12 @@ struct FrameBytes {
 }
 
 impl FrameBytes {
-    fn of(f: &crate::format::Format, s: StateReply) -> Self {
+    fn of(f: &snapgen_model::format::Format, s: StateReply) -> Self {
         let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
         let state = Reply::State(s).to_frame(0).to_bytes().len();
         let load = Command::LoadSegment {
             index: 0,
-            segment: crate::program::Segment { ticks: 1, snap: 0 },
+            segment: snapgen_model::program::Segment { ticks: 1, snap: 0 },
         };
         FrameBytes {
             read: frame_bytes(&Command::ReadState, f) + state,
@@ -459,7 +459,7 @@ impl<L: Link> Runner<'_, L> {
     fn arm(
         &mut self,
         at: u64,
-        program: &crate::program::Program,
+        program: &snapgen_model::program::Program,
     ) -> Result<Result<(), ()>, RunError> {
         let refused = |what: &'static str, reason: Reason| RunError::Board {
             what,
@@ -858,7 +858,10 @@ pub fn run<L: Link>(
 
 /// Writes the controlled stop's limits (raw) and powers the axis on (POWER 1; an axis already
 /// on is left so), as a run wants it.
-pub fn power_up<L: Link>(link: &mut L, stop: crate::stop::StopLimits) -> Result<(), RunError> {
+pub fn power_up<L: Link>(
+    link: &mut L,
+    stop: snapgen_model::stop::StopLimits,
+) -> Result<(), RunError> {
     use crate::protocol::Param;
     for c in [
         Command::Configure {
@@ -893,12 +896,12 @@ pub fn power_up<L: Link>(link: &mut L, stop: crate::stop::StopLimits) -> Result<
 pub fn stop_limits(
     deceleration: f64,
     jerk: f64,
-    format: &crate::format::Format,
-) -> crate::stop::StopLimits {
-    use crate::format::Quantity;
+    format: &snapgen_model::format::Format,
+) -> snapgen_model::stop::StopLimits {
     use crate::protocol::Param;
+    use snapgen_model::format::Quantity;
     let raw = |v: f64, q: Quantity, p: Param| {
-        let r = crate::planner::fmath::floor(v * format.scale(q));
+        let r = snapgen_plan::planner::fmath::floor(v * format.scale(q));
         if r >= p.max() as f64 {
             p.max()
         } else {
@@ -907,5 +910,5 @@ pub fn stop_limits(
     };
     let jerk = raw(jerk, Quantity::Jerk, Param::StopJerk);
     let accel = raw(deceleration, Quantity::Acceleration, Param::StopAccel).max(jerk);
-    crate::stop::StopLimits { jerk, accel }
+    snapgen_model::stop::StopLimits { jerk, accel }
 }

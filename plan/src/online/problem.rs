@@ -4,7 +4,7 @@
 
 use arrayvec::ArrayVec;
 
-use crate::chain::ChainState;
+use snapgen_model::chain::ChainState;
 
 use super::exact::{to_f64, Caps, Condition, DPiece, Problem, MAX_FREE, MAX_PIECES};
 use super::position::{self, PositionProfile};
@@ -368,7 +368,7 @@ pub(super) fn build(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::Widths;
+    use snapgen_model::format::Widths;
 
     /// The chain's registers are the continuous profile's X(k), V(k + ½), A(k + 1): a program
     /// of jerk pieces played tick by tick lands where the continuous profile from

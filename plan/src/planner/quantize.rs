@@ -7,7 +7,7 @@
 //! 1. Build the *unit program*: the profile's shape with amplitude 1 (order 4: ±1 snap
 //!    segments; orders 3 and 2: ±1 one-tick snap impulses that step the jerk, or impulse pairs
 //!    that step the acceleration).
-//! 2. Run it in closed form ([`crate::peaks`]): its exact end position `P` (the *position gain*)
+//! 2. Run it in closed form ([`snapgen_model::peaks`]): its exact end position `P` (the *position gain*)
 //!    and its exact register peaks. The chain is linear and starts at rest, so amplitude `K`
 //!    moves exactly `K·P` and peaks at exactly `K·peak`.
 //! 3. `K = round(X / P)` where `X` is the distance from the start register to the *centre* of
@@ -21,8 +21,8 @@
 //! end at exactly 0 for every amplitude.
 
 use super::PhaseTicks;
-use crate::format::Quantity;
-use crate::program::{Program, Segment};
+use snapgen_model::format::Quantity;
+use snapgen_model::program::{Program, Segment};
 
 /// Profile shapes the quantizer knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -404,8 +404,8 @@ mod tests {
 
     #[test]
     fn unit_peaks_match_the_chain() {
-        use crate::chain::ChainState;
-        use crate::peaks::peaks;
+        use snapgen_model::chain::ChainState;
+        use snapgen_model::peaks::peaks;
         for shape in [Shape::Snap4, Shape::Jerk3, Shape::Accel2] {
             for d in 0..4u64 {
                 for j in 0..4u64 {

@@ -6,11 +6,11 @@
 //! velocity is always reached; the cost is the time of stopping on the way
 //! ([`super::position::Branch::Stop`]). A blend point is not: it is refused.
 
-use crate::chain::ChainState;
 use crate::error::PlanError;
-use crate::format::Format;
 use crate::planner::{plan_from, Method, MoveRequest};
-use crate::program::Program;
+use snapgen_model::chain::ChainState;
+use snapgen_model::format::Format;
+use snapgen_model::program::Program;
 
 use super::position::Branch;
 use super::problem::Setup;
@@ -107,7 +107,7 @@ pub(super) fn stop_and_go(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::{Quantity, Widths};
+    use snapgen_model::format::{Quantity, Widths};
 
     /// Steps `program` from `s` tick by tick; the end, and whether every tick kept the
     /// velocity, acceleration (while |v| grows) or deceleration (while it shrinks) and (order 3)

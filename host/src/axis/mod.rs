@@ -4,7 +4,7 @@
 //! standard's function blocks do.
 //!
 //! The host computes, the fabric integrates. The axis keeps the [`Timeline`] the fabric plays:
-//! parts, each one command's piece of trajectory, planned with [`crate::online::plan_online`]
+//! parts, each one command's piece of trajectory, planned with [`snapgen_plan::online::plan_online`]
 //! from the exact state it starts in. Because the chain is bit-exact, the state at any future
 //! tick is known; a change (a new command, an override) is planned from the state at a swap
 //! tick `T` chosen ahead of the link's latency, uploaded to the standby bank and armed with
@@ -32,10 +32,10 @@ pub mod driver;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::chain::ChainState;
-use crate::format::Format;
-use crate::online::{OnlineError, OnlineLimits, OnlineOrder};
-use crate::program::{Program, Segment};
+use snapgen_model::chain::ChainState;
+use snapgen_model::format::Format;
+use snapgen_model::program::{Program, Segment};
+use snapgen_plan::online::{OnlineError, OnlineLimits, OnlineOrder};
 
 /// PLCopen's BufferMode of a move (how it follows the one before).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]

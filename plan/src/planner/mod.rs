@@ -18,13 +18,14 @@ pub mod quantize;
 use ethnum::I256;
 use serde::{Deserialize, Serialize};
 
-use crate::chain::ChainState;
-use crate::error::{PlanError, ProgramError};
-use crate::format::{Format, Quantity, FRAC_BITS};
-use crate::peaks::{peaks, Peaks};
-use crate::program::Program;
+use crate::error::PlanError;
 pub use duration::{DurationInput, DurationValues};
 use quantize::{unit_response, unit_ticks, Shape};
+use snapgen_model::chain::ChainState;
+use snapgen_model::error::ProgramError;
+use snapgen_model::format::{Format, Quantity, FRAC_BITS};
+use snapgen_model::peaks::{peaks, Peaks};
+use snapgen_model::program::Program;
 
 /// Phase times in ticks. Order 4: `d` = t_d, `j` = t_j, `a` = t_a, `v` = t_v (seed 000);
 /// order 3: `j`, `a`, `v` (jerk, constant acceleration, cruise; `d` = 0); order 2: `a`, `v`.
@@ -689,7 +690,7 @@ fn quantize_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::DEFAULT_FORMAT;
+    use snapgen_model::format::DEFAULT_FORMAT;
 
     fn order4(distance: f64) -> MoveRequest {
         MoveRequest {

@@ -11,7 +11,7 @@
 
 use arrayvec::ArrayVec;
 
-use crate::chain::ChainState;
+use snapgen_model::chain::ChainState;
 
 use super::exact::{linearise, to_f64, Caps, ExactFailure, Linear, Problem};
 

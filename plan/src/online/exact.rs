@@ -38,8 +38,8 @@
 
 use arrayvec::ArrayVec;
 
-use crate::chain::ChainState;
-use crate::program::{Program, Segment};
+use snapgen_model::chain::ChainState;
+use snapgen_model::program::{Program, Segment};
 
 /// Largest number of free levels.
 pub const MAX_FREE: usize = 4;
@@ -1040,7 +1040,7 @@ mod tests {
     /// The closed form of a piece equals the chain stepped tick by tick.
     #[test]
     fn a_piece_in_closed_form_is_the_chain_stepped() {
-        let w = crate::format::Widths {
+        let w = snapgen_model::format::Widths {
             x: 127,
             v: 127,
             a: 127,

@@ -7,8 +7,8 @@
 //!
 //! `cargo run --release -p snapgen-model --example replan_sweep`
 
-use snapgen_model::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
 use snapgen_model::{ChainState, DEFAULT_FORMAT};
+use snapgen_plan::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
 
 fn main() {
     let f = DEFAULT_FORMAT;

@@ -20,9 +20,9 @@ pub mod transition;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::chain::ChainState;
-use crate::format::{Format, Quantity, FRAC_BITS};
-use crate::program::Program;
+use snapgen_model::chain::ChainState;
+use snapgen_model::format::{Format, Quantity, FRAC_BITS};
+use snapgen_model::program::Program;
 
 use exact::{Caps, ExactFailure};
 use position::Branch;

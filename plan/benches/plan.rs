@@ -8,14 +8,15 @@
 //!   every tick's extremes (snapgen-verify). These cost per segment, not per tick, so they are
 //!   reported as time per move, not as ticks per second.
 //!
-//! Run with `cargo bench -p snapgen-model --bench model`. Criterion prints the median time per
+//! Run with `cargo bench -p snapgen-plan --bench plan`. Criterion prints the median time per
 //! iteration and, for `model_per_tick`, elements (ticks) per second. (`cargo bench -p snapgen-tests --bench vs_ruckig`
 //! compares the planner with Ruckig.)
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use snapgen_model::{plan, ChainState, Method, MoveRequest, DEFAULT_FORMAT};
+use snapgen_model::{ChainState, DEFAULT_FORMAT};
+use snapgen_plan::{plan, Method, MoveRequest};
 
 fn requests() -> Vec<(&'static str, MoveRequest)> {
     vec![

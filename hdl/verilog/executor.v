@@ -1,0 +1,546 @@
+// The command executor and axis state machine (docs/PROTOCOL.md; its reference, clock for
+// clock, is snapgen_model::io::executor::Executor). Template: snapgen_hdl fills the lines
+// marked //@ from the contract (the command table, one register per parameter) and puts the
+// localparams the body names in front of it (codes, reasons, states, widths, the design's
+// constants), so no code or width is typed here as a number.
+//
+// On each frame with a good CRC it checks the command (code, length, arguments, then the axis
+// state), applies its effect and queues its reply; a bad CRC or a dropped frame queues a NAK
+// with sequence 0. Every output is registered: a next-state block in the model's order, then
+// one register block.
+
+// ---- The frame's fields (byte k of an n-byte payload is payload[8(n-1-k) +: 8]) ----------------
+//@ payload_fields
+
+// ---- The command table: known, payload length, has an effect (a retry is not executed) --------
+reg known;
+reg [7:0] want_len;
+reg has_effect;
+always @(*) begin
+   known = 1'b0;
+   want_len = 8'd0;
+   has_effect = 1'b0;
+   case (cmd)
+   //@ command_table
+   default: ;
+   endcase
+end
+
+//@ param_functions
+
+reg cfg_over;                                    // the CONFIGURE value is above its maximum
+always @(*) begin
+   cfg_over = 1'b0;
+   case (cfg_param)
+   //@ param_over
+   default: ;
+   endcase
+end
+
+// ---- Registers --------------------------------------------------------------------------------
+reg [STATE_BITS-1:0] state_q = S_DISABLED, n_state;
+reg [15:0] enc_seen_q = 16'd0, n_enc_seen;       // encoder errors at the last RESET command
+reg servo_overrun_q = 1'b0, n_servo_overrun;     // the controller skipped a sample
+reg load_q = 1'b0, n_load;                       // the reference takes the encoder's position
+reg first_pos_q = 1'b0, n_first_pos;             // the standby program's segment 0 heads +
+reg first_neg_q = 1'b0, n_first_neg;             // ... or −
+reg [STATE_BITS-1:0] error_q = E_NONE, n_error;
+reg amplifier_q = 1'b0, n_amplifier;
+reg uart_error_q = 1'b0, n_uart_error;
+reg overflow_q = 1'b0, n_overflow;
+reg [15:0] bad_crc_q = 16'd0, n_bad_crc;
+reg [15:0] bad_frames_q = 16'd0, n_bad_frames;
+//@ param_registers
+reg write_enable_q = 1'b0, n_write_enable;
+reg [ADDR_BITS-1:0] write_address_q = {ADDR_BITS{1'b0}}, n_write_address;
+reg [TICK_BITS-1:0] write_ticks_q = {TICK_BITS{1'b0}}, n_write_ticks;
+reg [D_BITS-1:0] write_snap_q = {D_BITS{1'b0}}, n_write_snap;
+reg count_enable_q = 1'b0, n_count_enable;
+reg [INDEX_BITS-1:0] count_value_q = {INDEX_BITS{1'b0}}, n_count_value;
+reg start_q = 1'b0, n_start;
+reg swap_q = 1'b0, n_swap;
+reg [SWAP_BITS-1:0] swap_last_q = {SWAP_BITS{1'b0}}, n_swap_last;
+reg stop_q = 1'b0, n_stop;
+reg abort_q = 1'b0, n_abort;
+reg reply_q = 1'b0, n_reply;
+reg [KIND_BITS-1:0] reply_kind_q = {KIND_BITS{1'b0}}, n_reply_kind;
+reg [7:0] reply_cmd_q = 8'd0, n_reply_cmd;
+reg [7:0] reply_seq_q = 8'd0, n_reply_seq;
+reg [7:0] reply_aux_q = 8'd0, n_reply_aux;
+reg telemetry_q = 1'b0, n_telemetry;
+// The last command with an effect: code, sequence, CRC and its reply.
+reg last_valid_q = 1'b0, n_last_valid;
+reg [7:0] last_cmd_q = 8'd0, n_last_cmd;
+reg [7:0] last_seq_q = 8'd0, n_last_seq;
+reg [15:0] last_crc_q = 16'd0, n_last_crc;
+reg [KIND_BITS-1:0] last_kind_q = {KIND_BITS{1'b0}}, n_last_kind;
+reg [7:0] last_aux_q = 8'd0, n_last_aux;
+// The watchdog: clocks of the current millisecond, milliseconds since the last good frame.
+reg [31:0] prescale_q = 32'd0, n_prescale;
+reg [WATCHDOG_MS_BITS-1:0] watchdog_count_q = {WATCHDOG_MS_BITS{1'b0}}, n_watchdog_count;
+// Telemetry: ticks to the next frame; whether the chain was driven on the last clock.
+reg [TELEMETRY_PERIOD_BITS-1:0] telemetry_left_q = {TELEMETRY_PERIOD_BITS{1'b0}}, n_telemetry_left;
+reg was_driven_q = 1'b0, n_was_driven;
+
+// ---- Arguments and axis state: why the command is refused (0: accepted) ----------------------
+// The axis moves: a program plays, a stop runs, or v, a or j is not 0.
+wire moving = busy || stopping || !at_rest;
+wire stop_limits_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= stop_accel_q);
+// With the controller on, POWER 1 wants a following-error limit.
+wire servo_ready = (servo_period_q == {SERVO_PERIOD_BITS{1'b0}})
+   || (following_limit_q != {FOLLOWING_LIMIT_BITS{1'b0}});
+// The stop limits a CONFIGURE would leave valid (0 < jerk <= accel): each parameter's case
+// compares the new value with the other register (two comparators side by side, off the
+// parameter's multiplexer).
+wire jerk_pair_valid = (cfg_value != {D_BITS{1'b0}}) && (cfg_value <= stop_accel_q);
+wire accel_pair_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= cfg_value);
+wire cfg_pair_valid = (cfg_param == P_STOP_JERK) ? jerk_pair_valid
+   : ((cfg_param == P_STOP_ACCEL) ? accel_pair_valid : 1'b1);
+// SWAP_AT: how far its tick lies beyond the time base (signed, wrap-safe), registered every
+// clock (the payload is complete a byte before the frame is): one clock old when the frame is
+// executed, and the core arms one clock later, so the time base may have ticked twice by then;
+// the core wants three ticks of lead.
+reg [TIME_BITS-1:0] swap_lead_q = {TIME_BITS{1'b0}};
+always @(posedge clock) swap_lead_q <= reset ? {TIME_BITS{1'b0}} : (swap_tick - ticks);
+wire swap_late = swap_lead_q[TIME_BITS-1] || (swap_lead_q < SWAP_MIN_LEAD);
+// The core compares SWAP_BITS bits: a tick 2^(SWAP_BITS-1) ticks or more ahead is refused.
+wire swap_far = !swap_lead_q[TIME_BITS-1]
+   && (swap_lead_q[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
+wire [SWAP_BITS-1:0] swap_before = swap_tick[SWAP_BITS-1:0] - 1'b1;   // the core's swap_last: T − 1
+wire toward_limit = (first_pos_q && limit_pos) || (first_neg_q && limit_neg);
+reg [7:0] reason;
+always @(*) begin
+   reason = 8'd0;
+   case (cmd)
+   CMD_LOAD_SEGMENT:
+      if ((seg_index >= MAX_SEGMENTS) || (seg_ticks == {TICK_BITS{1'b0}})) reason = R_BAD_ARGUMENT;
+      else if (swap_pending) reason = R_SWAP_PENDING;
+   CMD_COMMIT:
+      if (arg0 > MAX_SEGMENTS) reason = R_BAD_ARGUMENT;
+      else if (swap_pending) reason = R_SWAP_PENDING;
+   CMD_START:
+      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
+      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
+      else if (state_q == S_STOPPING) reason = R_STOPPING;
+      else if (busy) reason = R_BUSY;
+      else if (stopping) reason = R_STOPPING;
+      else if (swap_pending) reason = R_SWAP_PENDING;
+      else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
+      else if (!at_rest) reason = R_BUSY;
+      else if (toward_limit) reason = R_LIMIT;
+   CMD_SWAP_AT:
+      if (swap_far) reason = R_BAD_ARGUMENT;
+      else if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
+      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
+      else if (state_q == S_STOPPING) reason = R_STOPPING;
+      else if (stopping) reason = R_STOPPING;
+      else if (swap_pending) reason = R_SWAP_PENDING;
+      else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
+      else if (swap_late) reason = R_LATE;
+      else if (at_rest && !busy && toward_limit) reason = R_LIMIT;
+   CMD_STOP:
+      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
+   CMD_HALT:
+      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
+      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
+      else if (state_q == S_STOPPING) reason = R_STOPPING;
+   CMD_CONFIGURE:
+      if (!param_known(cfg_param) || cfg_value[D_BITS-1] || cfg_over) reason = R_BAD_ARGUMENT;
+      else if (param_at_rest(cfg_param) && moving) reason = R_BUSY;
+      else if (param_disabled(cfg_param) && (state_q != S_DISABLED)) reason = R_NOT_DISABLED;
+      else if ((state_q != S_DISABLED) && ((cfg_param == P_STOP_JERK) || (cfg_param == P_STOP_ACCEL))
+            && !cfg_pair_valid) reason = R_BAD_ARGUMENT;
+   CMD_READ_CONFIG:
+      if (!param_known(arg0)) reason = R_BAD_ARGUMENT;
+   CMD_POWER:
+      if (arg0 > 8'd1) reason = R_BAD_ARGUMENT;
+      else if (arg0 == 8'd1) begin
+         if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
+         else if ((state_q == S_DISABLED) && (!stop_limits_valid || !servo_ready))
+            reason = R_NOT_CONFIGURED;
+      end else if (moving) reason = R_BUSY;
+   CMD_RESET:
+      if ((state_q == S_ERROR_STOP) && (moving || estop)) reason = R_AXIS_ERROR;
+   default: ;
+   endcase
+end
+
+wire retry = has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
+   && (crc == last_crc_q);
+wire expired = (watchdog_ms_q != {WATCHDOG_MS_BITS{1'b0}}) && (watchdog_count_q >= watchdog_ms_q);
+wire settling = start_q || stop_q || swap_q;     // a start, stop or swap the core takes now
+wire driven = busy || stopping;
+
+// ---- Next state, in the model's order ------------------------------------------------------
+always @(*) begin
+   // Pulses last one clock; everything else holds.
+   n_write_enable = 1'b0;
+   n_count_enable = 1'b0;
+   n_start = 1'b0;
+   n_swap = 1'b0;
+   n_swap_last = swap_last_q;
+   n_stop = 1'b0;
+   n_abort = 1'b0;
+   n_reply = 1'b0;
+   n_telemetry = 1'b0;
+   n_state = state_q;
+   n_enc_seen = enc_seen_q;
+   n_servo_overrun = servo_overrun_q;
+   n_load = 1'b0;
+   n_first_pos = first_pos_q;
+   n_first_neg = first_neg_q;
+   n_error = error_q;
+   n_amplifier = amplifier_q;
+   n_uart_error = uart_error_q;
+   n_overflow = overflow_q;
+   n_bad_crc = bad_crc_q;
+   n_bad_frames = bad_frames_q;
+   //@ param_holds
+   n_write_address = write_address_q;
+   n_write_ticks = write_ticks_q;
+   n_write_snap = write_snap_q;
+   n_count_value = count_value_q;
+   n_reply_kind = reply_kind_q;
+   n_reply_cmd = reply_cmd_q;
+   n_reply_seq = reply_seq_q;
+   n_reply_aux = reply_aux_q;
+   n_last_valid = last_valid_q;
+   n_last_cmd = last_cmd_q;
+   n_last_seq = last_seq_q;
+   n_last_crc = last_crc_q;
+   n_last_kind = last_kind_q;
+   n_last_aux = last_aux_q;
+   n_telemetry_left = telemetry_left_q;
+
+   // Telemetry while the chain is driven, and once when it stops being driven, from the period
+   // and countdown before this clock (a CONFIGURE of the period, below, restarts the countdown).
+   if (telemetry_period_q != {TELEMETRY_PERIOD_BITS{1'b0}}) begin
+      if (tick && driven) begin
+         if (telemetry_left_q <= {{(TELEMETRY_PERIOD_BITS-1){1'b0}}, 1'b1}) begin
+            n_telemetry = 1'b1;
+            n_telemetry_left = telemetry_period_q;
+         end else n_telemetry_left = telemetry_left_q - 1'b1;
+      end
+      if (was_driven_q && !driven) begin
+         n_telemetry = 1'b1;
+         n_telemetry_left = telemetry_period_q;
+      end
+   end
+   n_was_driven = driven;
+
+   // The watchdog: milliseconds since the last good frame (saturating).
+   n_prescale = prescale_q + 32'd1;
+   n_watchdog_count = watchdog_count_q;
+   if (frame) begin
+      n_prescale = 32'd0;
+      n_watchdog_count = {WATCHDOG_MS_BITS{1'b0}};
+   end else if (prescale_q + 32'd1 >= CLOCKS_PER_MS) begin
+      n_prescale = 32'd0;
+      if (watchdog_count_q != {WATCHDOG_MS_BITS{1'b1}}) n_watchdog_count = watchdog_count_q + 1'b1;
+   end
+
+   // Frames.
+   if (line_error) n_uart_error = 1'b1;
+   if (servo_overrun_in) n_servo_overrun = 1'b1;
+   if (bad_crc) begin
+      n_bad_crc = bad_crc_q + 16'd1;
+      if (queue_full) n_overflow = 1'b1;
+      else begin
+         n_reply = 1'b1;
+         n_reply_kind = K_NAK;
+         n_reply_cmd = 8'd0;
+         n_reply_seq = 8'd0;
+         n_reply_aux = R_BAD_CRC;
+      end
+   end else if (dropped) begin
+      n_bad_frames = bad_frames_q + 16'd1;
+      if (queue_full) n_overflow = 1'b1;
+      else begin
+         n_reply = 1'b1;
+         n_reply_kind = K_NAK;
+         n_reply_cmd = 8'd0;
+         n_reply_seq = 8'd0;
+         n_reply_aux = R_FRAMING;
+      end
+   end else if (frame) begin
+      n_reply_cmd = cmd;
+      n_reply_seq = seq;
+      if (queue_full) n_overflow = 1'b1;
+      else if (!known || (len != want_len)) begin
+         n_bad_frames = bad_frames_q + 16'd1;
+         n_reply = 1'b1;
+         n_reply_kind = K_NAK;
+         n_reply_aux = known ? R_BAD_LENGTH : R_UNKNOWN_COMMAND;
+      end else if (retry) begin
+         // A retry: the same answer, no effect.
+         n_reply = 1'b1;
+         n_reply_kind = last_kind_q;
+         n_reply_aux = last_aux_q;
+      end else begin
+         // PING: a new host session; no command before it is retried.
+         if (cmd == CMD_PING) n_last_valid = 1'b0;
+         n_reply = 1'b1;
+         n_reply_kind = K_ACK;
+         n_reply_aux = 8'd0;
+         if (reason != 8'd0) begin
+            n_reply_kind = K_NAK;
+            n_reply_aux = reason;
+         end else case (cmd)
+         CMD_PING: n_reply_kind = K_IDENTITY;
+         CMD_READ_STATUS: n_reply_kind = K_STATUS;
+         CMD_READ_STATE: n_reply_kind = K_STATE;
+         CMD_READ_CONFIG: begin
+            n_reply_kind = K_CONFIG;
+            n_reply_aux = arg0;
+         end
+         CMD_LOAD_SEGMENT: begin
+            n_write_enable = 1'b1;
+            n_write_address = seg_index[ADDR_BITS-1:0];
+            n_write_ticks = seg_ticks;
+            n_write_snap = seg_snap;
+            if (seg_index[ADDR_BITS-1:0] == {ADDR_BITS{1'b0}}) begin
+               n_first_pos = !seg_snap[D_BITS-1] && (seg_snap != {D_BITS{1'b0}});
+               n_first_neg = seg_snap[D_BITS-1];
+            end
+         end
+         CMD_COMMIT: begin
+            n_count_enable = 1'b1;
+            n_count_value = arg0[INDEX_BITS-1:0];
+         end
+         CMD_START: begin
+            n_start = 1'b1;
+            n_state = S_DISCRETE_MOTION;
+            // The banks swap: the new standby program is empty.
+            n_first_pos = 1'b0;
+            n_first_neg = 1'b0;
+         end
+         CMD_SWAP_AT: begin
+            n_swap = 1'b1;
+            n_swap_last = swap_before;
+            n_state = S_DISCRETE_MOTION;
+            // The banks swap at the tick; no upload is taken before that.
+            n_first_pos = 1'b0;
+            n_first_neg = 1'b0;
+         end
+         CMD_STOP:
+            if (state_q != S_ERROR_STOP) begin
+               n_stop = 1'b1;
+               n_state = S_STOPPING;
+            end
+         CMD_HALT:
+            if ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION)) n_stop = 1'b1;
+         CMD_CONFIGURE: begin
+            case (cfg_param)
+            //@ param_set
+            default: ;
+            endcase
+            if (cfg_param == P_TELEMETRY_PERIOD)
+               n_telemetry_left = cfg_value[TELEMETRY_PERIOD_BITS-1:0];
+         end
+         CMD_POWER:
+            if (arg0 == 8'd1) begin
+               if (state_q == S_DISABLED) begin
+                  n_amplifier = 1'b1;
+                  n_state = S_STANDSTILL;
+                  n_load = 1'b1;                 // MC_Power: the axis holds where it is
+               end
+            end else begin
+               n_amplifier = 1'b0;
+               if (state_q == S_STANDSTILL) n_state = S_DISABLED;
+            end
+         CMD_RESET: begin
+            // The sticky flags clear in any state.
+            n_uart_error = 1'b0;
+            n_overflow = 1'b0;
+            n_servo_overrun = 1'b0;
+            n_enc_seen = encoder_errors;
+            if (state_q == S_ERROR_STOP) begin
+               n_error = E_NONE;
+               n_state = amplifier_q ? S_STANDSTILL : S_DISABLED;
+            end
+         end
+         default: ;
+         endcase
+         if (has_effect) begin
+            n_last_valid = 1'b1;
+            n_last_cmd = cmd;
+            n_last_seq = seq;
+            n_last_crc = crc;
+            n_last_kind = n_reply_kind;
+            n_last_aux = n_reply_aux;
+         end
+      end
+   end
+
+   // The axis by itself: the end of a move or a stop (at rest: Standstill; a program that ended
+   // moving: a controlled stop into ErrorStop), then the errors (the emergency stop last: it
+   // overrides everything).
+   if (((n_state == S_DISCRETE_MOTION) || (n_state == S_CONTINUOUS_MOTION) || (n_state == S_STOPPING))
+         && (state_q == n_state) && !busy && !stopping && !settling
+         && !(at_rest && swap_pending)) begin   // a swap armed at rest: a start to come
+      if (at_rest) n_state = S_STANDSTILL;
+      else begin
+         n_stop = 1'b1;
+         n_state = S_ERROR_STOP;
+         n_error = E_PROGRAM_END;
+      end
+   end
+   if (expired && ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION))) begin
+      n_stop = 1'b1;
+      n_state = S_ERROR_STOP;
+      n_error = E_WATCHDOG;
+   end
+   if ((state_q != S_ERROR_STOP) && (state_q != S_DISABLED)) begin
+      if (limit_pos && heading_pos) begin
+         n_stop = 1'b1;
+         n_state = S_ERROR_STOP;
+         n_error = E_LIMIT_POSITIVE;
+      end else if (limit_neg && heading_neg) begin
+         n_stop = 1'b1;
+         n_state = S_ERROR_STOP;
+         n_error = E_LIMIT_NEGATIVE;
+      end
+   end
+   if (following_fault && n_amplifier) begin
+      n_abort = 1'b1;
+      n_stop = 1'b0;
+      n_start = 1'b0;
+      n_swap = 1'b0;
+      n_amplifier = 1'b0;
+      n_state = S_ERROR_STOP;
+      n_error = E_FOLLOWING_ERROR;
+   end
+   if (estop && !((state_q == S_ERROR_STOP) && (error_q == E_EMERGENCY_STOP))) begin
+      n_abort = 1'b1;
+      n_stop = 1'b0;
+      n_start = 1'b0;
+      n_swap = 1'b0;
+      n_amplifier = 1'b0;
+      n_state = S_ERROR_STOP;
+      n_error = E_EMERGENCY_STOP;
+   end
+
+end
+
+always @(posedge clock) begin
+   if (reset) begin
+      state_q <= S_DISABLED;
+      enc_seen_q <= 16'd0;
+      servo_overrun_q <= 1'b0;
+      load_q <= 1'b0;
+      first_pos_q <= 1'b0;
+      first_neg_q <= 1'b0;
+      error_q <= E_NONE;
+      amplifier_q <= 1'b0;
+      uart_error_q <= 1'b0;
+      overflow_q <= 1'b0;
+      bad_crc_q <= 16'd0;
+      bad_frames_q <= 16'd0;
+      //@ param_resets
+      write_enable_q <= 1'b0;
+      write_address_q <= {ADDR_BITS{1'b0}};
+      write_ticks_q <= {TICK_BITS{1'b0}};
+      write_snap_q <= {D_BITS{1'b0}};
+      count_enable_q <= 1'b0;
+      count_value_q <= {INDEX_BITS{1'b0}};
+      start_q <= 1'b0;
+      swap_q <= 1'b0;
+      swap_last_q <= {SWAP_BITS{1'b0}};
+      stop_q <= 1'b0;
+      abort_q <= 1'b0;
+      reply_q <= 1'b0;
+      reply_kind_q <= {KIND_BITS{1'b0}};
+      reply_cmd_q <= 8'd0;
+      reply_seq_q <= 8'd0;
+      reply_aux_q <= 8'd0;
+      telemetry_q <= 1'b0;
+      last_valid_q <= 1'b0;
+      last_cmd_q <= 8'd0;
+      last_seq_q <= 8'd0;
+      last_crc_q <= 16'd0;
+      last_kind_q <= {KIND_BITS{1'b0}};
+      last_aux_q <= 8'd0;
+      prescale_q <= 32'd0;
+      watchdog_count_q <= {WATCHDOG_MS_BITS{1'b0}};
+      telemetry_left_q <= {TELEMETRY_PERIOD_BITS{1'b0}};
+      was_driven_q <= 1'b0;
+   end else begin
+      state_q <= n_state;
+      enc_seen_q <= n_enc_seen;
+      servo_overrun_q <= n_servo_overrun;
+      load_q <= n_load;
+      first_pos_q <= n_first_pos;
+      first_neg_q <= n_first_neg;
+      error_q <= n_error;
+      amplifier_q <= n_amplifier;
+      uart_error_q <= n_uart_error;
+      overflow_q <= n_overflow;
+      bad_crc_q <= n_bad_crc;
+      bad_frames_q <= n_bad_frames;
+      //@ param_clocked
+      write_enable_q <= n_write_enable;
+      write_address_q <= n_write_address;
+      write_ticks_q <= n_write_ticks;
+      write_snap_q <= n_write_snap;
+      count_enable_q <= n_count_enable;
+      count_value_q <= n_count_value;
+      start_q <= n_start;
+      swap_q <= n_swap;
+      swap_last_q <= n_swap_last;
+      stop_q <= n_stop;
+      abort_q <= n_abort;
+      reply_q <= n_reply;
+      reply_kind_q <= n_reply_kind;
+      reply_cmd_q <= n_reply_cmd;
+      reply_seq_q <= n_reply_seq;
+      reply_aux_q <= n_reply_aux;
+      telemetry_q <= n_telemetry;
+      last_valid_q <= n_last_valid;
+      last_cmd_q <= n_last_cmd;
+      last_seq_q <= n_last_seq;
+      last_crc_q <= n_last_crc;
+      last_kind_q <= n_last_kind;
+      last_aux_q <= n_last_aux;
+      prescale_q <= n_prescale;
+      watchdog_count_q <= n_watchdog_count;
+      telemetry_left_q <= n_telemetry_left;
+      was_driven_q <= n_was_driven;
+   end
+end
+
+always @(*) begin
+   write_enable = write_enable_q;
+   write_address = write_address_q;
+   write_ticks = write_ticks_q;
+   write_snap = write_snap_q;
+   count_enable = count_enable_q;
+   count_value = count_value_q;
+   start = start_q;
+   swap = swap_q;
+   swap_last = swap_last_q;
+   stop = stop_q;
+   abort_move = abort_q;
+   load = load_q;
+   servo_overrun = servo_overrun_q;
+   //@ param_outputs
+   state = {{(8 - STATE_BITS){1'b0}}, state_q};   // the status block's byte
+   error = {{(8 - STATE_BITS){1'b0}}, error_q};
+   amplifier = amplifier_q;
+   uart_error = uart_error_q;
+   reply_overflow = overflow_q;
+   encoder_errors_seen = enc_seen_q;
+   // READ_CONFIG's value, for the reply transmitter.
+   read_value = {D_BITS{1'b0}};
+   case (read_param)
+   //@ param_read
+   default: ;
+   endcase
+   bad_crc_count = bad_crc_q;
+   bad_frames_count = bad_frames_q;
+   reply = reply_q;
+   reply_kind = reply_kind_q;
+   reply_cmd = reply_cmd_q;
+   reply_seq = reply_seq_q;
+   reply_aux = reply_aux_q;
+   telemetry = telemetry_q;
+end

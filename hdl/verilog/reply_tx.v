@@ -1,0 +1,114 @@
+// The reply transmitter (its reference is snapgen_model::io::reply_tx::ReplyTx). Template:
+// snapgen_hdl fills the values in double braces from the payload layouts (snapgen_spec::fields)
+// and the line //@ crc_function with the CRC step, and puts the codes and kinds it names in front of it as localparams.
+//
+// When idle it takes the reply queue's head, or else a pending telemetry frame, reads its
+// payload from the live values of that clock, and writes the frame (start byte, length, code,
+// sequence, payload, CRC low then high) into the transmit FIFO one byte per clock while the
+// FIFO is not full. The payload is held in a shift register and sent from its low byte.
+
+// ---- The reply launched on this clock, and its payload (byte 0 in bits 7:0) -------------------
+wire launch_head = !active_q && head_valid;
+wire launch_telemetry = !active_q && !head_valid && (pending_q || telemetry);
+wire [KIND_BITS-1:0] kind = launch_head ? head_kind : K_TELEMETRY;
+wire [{{ID_TOP}}:0] identity_payload = {{IDENTITY}};
+wire [{{STATE_TOP}}:0] state_payload = {{STATE}};
+wire [{{CONFIG_TOP}}:0] config_payload = {{CONFIG}};
+reg [7:0] new_len;
+reg [7:0] new_code;
+reg [{{PAYLOAD_TOP}}:0] new_payload;
+always @(*) begin
+   case (kind)
+   K_IDENTITY: begin
+      new_len = 8'd{{ID_BYTES}};
+      new_code = RC_IDENTITY;
+      new_payload = {{ID_PADDED}};
+   end
+   K_ACK: begin
+      new_len = 8'd{{ACK_BYTES}};
+      new_code = RC_ACK;
+      new_payload = {{ACK_PADDED}};
+   end
+   K_NAK: begin
+      new_len = 8'd{{NAK_BYTES}};
+      new_code = RC_NAK;
+      new_payload = {{NAK_PADDED}};
+   end
+   K_STATUS: begin
+      new_len = 8'd{{STATUS_BYTES}};
+      new_code = RC_STATUS;
+      new_payload = {{STATUS_PADDED}};
+   end
+   K_STATE: begin
+      new_len = 8'd{{STATE_BYTES}};
+      new_code = RC_STATE;
+      new_payload = {{STATE_PADDED}};
+   end
+   K_CONFIG: begin
+      new_len = 8'd{{CONFIG_BYTES}};
+      new_code = RC_CONFIG;
+      new_payload = {{CONFIG_PADDED}};
+   end
+   default: begin                                // telemetry: the status block
+      new_len = 8'd{{STATUS_BYTES}};
+      new_code = RC_TELEMETRY;
+      new_payload = {{STATUS_PADDED}};
+   end
+   endcase
+end
+
+// ---- The frame being written ---------------------------------------------------------------
+reg active_q = 1'b0;
+reg [7:0] index_q = 8'd0;                        // byte of the frame written next
+reg [7:0] len_q = 8'd0;
+reg [7:0] code_q = 8'd0;
+reg [7:0] seq_q = 8'd0;
+reg [{{PAYLOAD_TOP}}:0] payload_q = {{PAYLOAD_BITS}}'d0;   // the bytes not yet written, next in 7:0
+reg [15:0] crc_q = 16'd0;
+reg pending_q = 1'b0;                            // a telemetry frame waits
+wire writing = !reset && active_q && !fifo_full;
+wire [7:0] payload_end = len_q + 8'd4;           // index of the CRC's low byte
+reg [7:0] data;
+always @(*) begin
+   if (index_q == 8'd0) data = START_BYTE;
+   else if (index_q == 8'd1) data = len_q;
+   else if (index_q == 8'd2) data = code_q;
+   else if (index_q == 8'd3) data = seq_q;
+   else if (index_q < payload_end) data = payload_q[7:0];
+   else if (index_q == payload_end) data = crc_q[7:0];
+   else data = crc_q[15:8];
+end
+
+//@ crc_function
+always @(posedge clock) begin
+   if (reset) begin
+      active_q <= 1'b0;
+      index_q <= 8'd0;
+      pending_q <= 1'b0;
+   end else begin
+      if (!active_q) begin
+         if (launch_head || launch_telemetry) begin
+            active_q <= 1'b1;
+            index_q <= 8'd0;
+            len_q <= new_len;
+            code_q <= new_code;
+            seq_q <= launch_head ? head_seq : 8'd0;
+            payload_q <= new_payload;
+            crc_q <= CRC_INIT;
+         end
+      end else if (writing) begin
+         if ((index_q >= 8'd1) && (index_q < payload_end)) crc_q <= crc16_step(crc_q, data);
+         if ((index_q >= 8'd4) && (index_q < payload_end)) payload_q <= payload_q >> 8;
+         index_q <= index_q + 8'd1;
+         if (index_q == payload_end + 8'd1) active_q <= 1'b0;
+      end
+      if (launch_telemetry) pending_q <= 1'b0;
+      else if (telemetry) pending_q <= 1'b1;
+   end
+end
+
+always @(*) begin
+   pop = !reset && launch_head;
+   fifo_write = writing;
+   fifo_data = data;
+end

@@ -1,0 +1,200 @@
+// The position controller (its reference is snapgen_model::io::servo): PID on the following
+// error with velocity and acceleration feed-forward, computed digit-serially. Template:
+// snapgen_hdl fills the values in double braces (the law's shifts and the serial schedule,
+// from snapgen_model::io::servo); its configuration inputs are the contract's servo
+// parameters, named as their registers.
+
+// Fixed point (snapgen_model::io::servo): e in counts * 2^-{{E_FRAC}}, vs = v >>> {{V_SHIFT}},
+// as = a >>> {{A_SHIFT}}, u = (sum + 2^{{HALF}}) >>> {{OUT_SHIFT}}; {{LATENCY}} clocks from sample to duty.
+reg [SERVO_PERIOD_BITS-1:0] divider = {SERVO_PERIOD_BITS{1'b0}};   // ticks to the next sample
+reg busy = 1'b0;
+reg step0 = 1'b0;                    // the first clock after a sample
+reg [2:0] term = 3'd0;               // 0 e, 1 I, 2 D, 3 vs, 4 as
+reg [2:0] digit = 3'd0;              // 0..{{LAST_DIGIT}}: a gain digit's products; 1..{{DIGITS}}: their
+                                     // addition a clock later; {{SUM_CLOCK}}: into the sum
+reg fin = 1'b0;                      // the last clock: round and saturate
+reg [47:0] e48_q = 48'd0;            // the sample's following error
+reg [55:0] vs_q = 56'd0;             // v[103:48]
+reg [63:0] as_q = 64'd0;             // a[103:40]
+reg [47:0] f_q = 48'd0;              // the derivative filter's state F (the operand: F >>> k)
+reg [47:0] i_q = 48'd0;              // the integrator
+reg [31:0] eprev_q = 32'd0;
+reg primed = 1'b0;                   // a sample since the amplifier came on
+reg sat_hi = 1'b0, sat_lo = 1'b0;    // the last output was clamped
+reg [63:0] mag_q = 64'd0;            // the term's operand: magnitude, sign
+reg neg_q = 1'b0;
+reg [47:0] gain_q = 48'd0;           // the term's gain
+reg [111:0] acc_q = 112'd0;          // gain * |operand|, digit by digit
+reg [31:0] p0 = 32'd0, p1 = 32'd0, p2 = 32'd0, p3 = 32'd0;   // a digit's products, registered
+/* verilator lint_off UNUSEDSIGNAL */ // the fraction below bit 47 is what the rounding drops
+reg [115:0] sum_q = 116'd0;          // the terms so far (two's complement)
+/* verilator lint_on UNUSEDSIGNAL */
+// The configuration latched at the sample (a CONFIGURE meanwhile waits for the next sample).
+reg [KP_BITS-1:0] kp_q = {KP_BITS{1'b0}};
+reg [KI_BITS-1:0] ki_q = {KI_BITS{1'b0}};
+reg [KD_BITS-1:0] kd_q = {KD_BITS{1'b0}};
+reg [KV_BITS-1:0] kv_q = {KV_BITS{1'b0}};
+reg [KA_BITS-1:0] ka_q = {KA_BITS{1'b0}};
+reg [INTEGRAL_LIMIT_BITS-1:0] ilim_q = {INTEGRAL_LIMIT_BITS{1'b0}};
+reg [OUTPUT_LIMIT_BITS-1:0] olim_q = {OUTPUT_LIMIT_BITS{1'b0}};
+reg [FOLLOWING_LIMIT_BITS-1:0] flim_q = {FOLLOWING_LIMIT_BITS{1'b0}};
+reg [D_FILTER_BITS-1:0] dfk_q = {D_FILTER_BITS{1'b0}};
+reg [15:0] duty_q = 16'd0;
+reg fault_q = 1'b0, overrun_q = 1'b0;
+reg [31:0] peak_q = 32'd0;
+
+// The sample's error.
+wire due = tick && (servo_period != {SERVO_PERIOD_BITS{1'b0}})
+   && (divider == {SERVO_PERIOD_BITS{1'b0}});
+wire [47:0] e48_now = ref_position - {count, 16'h8000};   // count n: the centre of cell n
+
+// Step 0: saturation, following check, D and the integrator.
+wire e_sat_hi = !e48_q[47] && (e48_q[46:31] != 16'd0);
+wire e_sat_lo = e48_q[47] && (e48_q[46:31] != 16'hffff);
+wire [31:0] e_sat = e_sat_hi ? 32'h7fff_ffff : (e_sat_lo ? 32'h8000_0000 : e48_q[31:0]);
+wire [47:0] e48_abs = e48_q[47] ? (~e48_q + 48'd1) : e48_q;       // |-2^47| = 2^47 fits
+wire fault_now = e48_abs > {flim_q, 16'd0};
+wire [31:0] e_abs = e_sat[31] ? (~e_sat + 32'd1) : e_sat;          // 2^31 fits
+wire [32:0] delta = primed ? ({e_sat[31], e_sat} - {eprev_q[31], eprev_q}) : 33'd0;
+wire [47:0] d_filt = $signed(f_q) >>> dfk_q;                       // F >>> k
+wire [47:0] f_next = f_q + {{15{delta[32]}}, delta} - d_filt; // F + Δ − (F >>> k)
+wire hold = (sat_hi && !e_sat[31] && (e_sat != 32'd0)) || (sat_lo && e_sat[31]);
+wire [48:0] i_sum = {i_q[47], i_q} + {{17{e_sat[31]}}, e_sat};
+wire [48:0] i_lim = {1'b0, ilim_q};
+wire [48:0] i_neg_lim = ~i_lim + 49'd1;
+wire i_over = !i_sum[48] && (i_sum > i_lim);
+wire i_under = i_sum[48] && ($signed(i_sum) < $signed(i_neg_lim));
+wire [47:0] i_next = hold ? i_q : (i_over ? i_lim[47:0] : (i_under ? i_neg_lim[47:0] : i_sum[47:0]));
+
+// The next term's operand (sign-extended to 64 bits) and gain: term 0 on step 0, else term + 1.
+wire [2:0] next_term = step0 ? 3'd0 : term + 3'd1;
+reg [63:0] op;
+reg [47:0] next_gain;
+always @(*) begin
+   case (next_term)
+   3'd0: begin op = {{32{e_sat[31]}}, e_sat}; next_gain = kp_q; end
+   3'd1: begin op = {{16{i_q[47]}}, i_q}; next_gain = ki_q; end
+   3'd2: begin op = {{16{d_filt[47]}}, d_filt}; next_gain = kd_q; end   // F updated on step 0
+   3'd3: begin op = {{8{vs_q[55]}}, vs_q}; next_gain = kv_q; end
+   default: begin op = as_q; next_gain = ka_q; end
+   endcase
+end
+wire [63:0] op_mag = op[63] ? (~op + 64'd1) : op;                   // |-2^63| = 2^63 fits
+
+// One gain digit (most significant first) times the magnitude: four 16 x 16 products,
+// registered; added to the accumulator on the next clock.
+wire [15:0] g = (digit == 3'd0) ? gain_q[47:32] : ((digit == 3'd1) ? gain_q[31:16] : gain_q[15:0]);
+wire [79:0] partial = {16'd0, p2, p0} + {p3, p1, 16'd0};
+wire [111:0] acc_next = {acc_q[95:0], 16'd0} + {32'd0, partial};
+
+// Finish: round to nearest (halves up): (sum + 2^47) >>> 48 = sum[115:48] + sum[47]; saturate.
+wire [67:0] u = sum_q[115:48] + {67'd0, sum_q[47]};
+wire [67:0] lim = {52'd0, olim_q};
+wire [67:0] neg_lim = ~lim + 68'd1;
+wire u_hi = $signed(u) > $signed(lim);
+wire u_lo = $signed(u) < $signed(neg_lim);
+
+always @(posedge clock) begin
+   fault_q <= 1'b0;
+   overrun_q <= 1'b0;
+   if (reset || start) peak_q <= 32'd0;
+   if (reset || !enable) begin
+      divider <= {SERVO_PERIOD_BITS{1'b0}};
+      busy <= 1'b0;
+      step0 <= 1'b0;
+      term <= 3'd0;
+      digit <= 3'd0;
+      fin <= 1'b0;
+      p0 <= 32'd0;
+      p1 <= 32'd0;
+      p2 <= 32'd0;
+      p3 <= 32'd0;
+      e48_q <= 48'd0;
+      vs_q <= 56'd0;
+      as_q <= 64'd0;
+      f_q <= 48'd0;
+      i_q <= 48'd0;
+      eprev_q <= 32'd0;
+      primed <= 1'b0;
+      sat_hi <= 1'b0;
+      sat_lo <= 1'b0;
+      mag_q <= 64'd0;
+      neg_q <= 1'b0;
+      gain_q <= 48'd0;
+      acc_q <= 112'd0;
+      sum_q <= 116'd0;
+      duty_q <= 16'd0;
+   end else begin
+      if (tick && (servo_period != {SERVO_PERIOD_BITS{1'b0}}))
+         divider <= (divider == {SERVO_PERIOD_BITS{1'b0}}) ? servo_period - 1'b1 : divider - 1'b1;
+      if (due && busy) overrun_q <= 1'b1;
+      else if (due) begin
+         e48_q <= e48_now;
+         vs_q <= velocity;
+         as_q <= accel;
+         kp_q <= kp;
+         ki_q <= ki;
+         kd_q <= kd;
+         kv_q <= kv;
+         ka_q <= ka;
+         ilim_q <= integral_limit;
+         olim_q <= output_limit;
+         flim_q <= following_limit;
+         dfk_q <= d_filter;
+         busy <= 1'b1;
+         step0 <= 1'b1;
+      end
+      if (busy) begin
+         if (step0) begin
+            fault_q <= fault_now;
+            if (!start && (e_abs > peak_q)) peak_q <= e_abs;
+            f_q <= f_next;
+            i_q <= i_next;
+            eprev_q <= e_sat;
+            primed <= 1'b1;
+            sum_q <= 116'd0;
+            acc_q <= 112'd0;
+            mag_q <= op_mag;
+            neg_q <= op[63];
+            gain_q <= next_gain;
+            step0 <= 1'b0;
+            term <= 3'd0;
+            digit <= 3'd0;
+         end else if (!fin) begin
+            if (digit != 3'd{{SUM_CLOCK}}) begin
+               if (digit != 3'd0) acc_q <= acc_next;
+               if (digit < 3'd{{DIGITS}}) begin
+                  p0 <= g * mag_q[15:0];
+                  p1 <= g * mag_q[31:16];
+                  p2 <= g * mag_q[47:32];
+                  p3 <= g * mag_q[63:48];
+               end
+               digit <= digit + 3'd1;
+            end else begin
+               sum_q <= neg_q ? sum_q - {4'd0, acc_q} : sum_q + {4'd0, acc_q};
+               acc_q <= 112'd0;
+               digit <= 3'd0;
+               if (term != 3'd{{LAST_TERM}}) begin
+                  mag_q <= op_mag;
+                  neg_q <= op[63];
+                  gain_q <= next_gain;
+                  term <= term + 3'd1;
+               end else fin <= 1'b1;
+            end
+         end else begin
+            sat_hi <= u_hi;
+            sat_lo <= u_lo;
+            duty_q <= u_hi ? olim_q : (u_lo ? neg_lim[15:0] : u[15:0]);
+            busy <= 1'b0;
+            fin <= 1'b0;
+         end
+      end
+   end
+end
+
+always @(*) begin
+   duty = duty_q;
+   fault = fault_q;
+   overrun = overrun_q;
+   peak = peak_q;
+end

@@ -1,0 +1,255 @@
+// The stop unit's engine (its reference is snapgen_model::stop::micro, the law
+// snapgen_model::stop): a word-serial microcoded datapath over 48-bit words that brings the
+// chain to rest within its limits. Template: snapgen_hdl fills the values in double braces
+// (the microprogram's entry points, widths of the ROM and the flags) and the //@ lines (the
+// ROM, the instruction fields, the law's case analysis, the external operands) from the
+// model's microprogram, and puts the widths it names (D_BITS) in front as localparams.
+//
+// The engine's datapath (operand reads, the adder, the flag logic, the next program counter)
+// is computed in its clocked process, under the phase that uses it: a simulator evaluates none
+// of it while the unit is idle.
+
+// ---- The engine (snapgen_model::stop::micro): phases, registers -------------------------------
+// An instruction that computes takes 4 clocks (step 0..3): step s reads operand word s (for
+// s < 3) and adds word s - 1 (for s > 0); step 0 also samples the conditions. LOOP and HALT
+// take one clock. The instruction register holds ROM[pc]; both move as the engine runs.
+localparam [2:0] PH_IDLE = 3'd0, PH_PREP = 3'd1, PH_ARMED = 3'd2, PH_RUN = 3'd3, PH_READY = 3'd4;
+localparam [6:0] PC_PREP = 7'd{{PC_PREP}}, PC_INIT = 7'd{{PC_INIT}}, PC_DECIDE = 7'd{{PC_DECIDE}};
+localparam [31:0] FLAG_COUNT = {{FLAGS}};       // the engine's flags (snapgen_model::stop::micro)
+localparam [1:0] K_OP = 2'd{{K_OP}}, K_LOOP = 2'd{{K_LOOP}}, K_HALT = 2'd{{K_HALT}};
+// A shifts (0: none), B modes (0: none), flag sources (5: a condition), flag writes (0: none,
+// 1: set).
+localparam [2:0] M_SHL = 3'd1, M_WRIGHT = 3'd2, M_WLEFT2 = 3'd3, M_SHR = 3'd4;
+localparam [2:0] B_ADD = 3'd1, B_SUB = 3'd2, B_SUBONE = 3'd3, B_ADDSUB = 3'd4, B_ADDIF = 3'd5;
+localparam [2:0] S_SIGN = 3'd0, S_NSIGN = 3'd1, S_ZERO_A = 3'd2, S_SHIFT = 3'd3, S_WIDE_A = 3'd4;
+localparam [1:0] C_AND = 2'd2, C_OR = 2'd3;
+//@ flag_names
+reg [2:0] phase = PH_IDLE;
+reg [6:0] pc = 7'd0;
+reg [{{ROM_TOP}}:0] ir = {{IR_HALT}};             // the instruction at pc
+reg [1:0] step = 2'd0;
+reg [5:0] loop_count = 6'd0;
+reg [6:0] loop_pc = 7'd0;
+reg [47:0] a_q = 48'd0;                  // operand words read on the previous clock
+reg [47:0] b_q = 48'd0;
+// The instruction decoded on step 0 (its conditions evaluated), for the adding steps.
+reg c_shift_in = 1'b0;                   // the bit shifted into a left shift
+reg c_pred = 1'b0;                       // write the result and the flag
+reg c_flag = 1'b0;                       // a flag set from a condition
+reg do_shl = 1'b0, do_shr = 1'b0;        // A shifted one bit left, right
+reg b_en = 1'b0, b_inv = 1'b0;           // B added, inverted
+reg cin0 = 1'b0;                         // carry into word 0
+reg [FLAG_COUNT-1:0] flag_we = {FLAG_COUNT{1'b0}};  // the flag written (one-hot)
+reg flag_and = 1'b0, flag_or = 1'b0;     // combined by AND, OR (else set)
+reg [5:0] src = 6'd0;                    // flag source: sign, !sign, zero, shift, wide, cond
+reg carry = 1'b0;                        // between words: the adder's carry,
+reg shift_bit = 1'b0;                    // the bit a shift moves across,
+reg zero_acc = 1'b0;                     // the result is zero so far,
+reg fill = 1'b0;                         // the sign of a one-word right shift's source
+reg [FLAG_COUNT-1:0] flags = {FLAG_COUNT{1'b0}};
+reg [D_BITS-1:0] jlim = {D_BITS{1'b0}};     // the limits, latched on the request
+reg [D_BITS-1:0] alim = {D_BITS{1'b0}};
+reg [D_BITS-1:0] snap_reg = {D_BITS{1'b0}};
+reg [47:0] rf [0:63];                    // 16 registers x 4 word slots (3 used), LUT-RAM
+integer rf_i;
+initial for (rf_i = 0; rf_i < 64; rf_i = rf_i + 1) rf[rf_i] = 48'd0;
+
+// ---- The microprogram (snapgen_model::stop::program) -----------------------------------------
+function automatic [{{ROM_TOP}}:0] rom(input [6:0] addr);
+   case (addr)
+//@ rom_cases
+   endcase
+endfunction
+//@ instruction_fields
+// ---- Conditions: flags, the law's case analysis on them (micro::Derived), true -------------
+// (The engine's process writes every selection out: a function's arguments and locals cost a
+// simulator stores on every clock, executed or not.)
+
+wire running = (phase == PH_PREP) || (phase == PH_RUN);
+
+// ---- The engine: one clocked process; its datapath is evaluated only while it runs ---------
+always @(posedge clock) begin : engine
+   // Read: operand words for word `step` (high word first for a right shift).
+   reg shr;
+   reg [1:0] kr, ak, ke;
+   reg [2:0] ak_wide;
+   reg a_below, a_above;
+   reg [47:0] a_ext, a_raw;
+   // Add: word step - 1, from the words read.
+   reg first, last, shift_out, a_zero, a_wide, f_src, write;
+   reg [47:0] a_op, b_op, result;
+   reg [48:0] sum;
+   reg [FLAG_COUNT-1:0] f_new;
+   reg [31:0] conds;
+   reg [6:0] pc_next;
+   reg fetch;                            // load pc and ir (with ROM[pc_next])
+   // The law's case analysis on the flags (micro::Derived), for the step-0 conditions.
+//@ derived_declarations
+   // The step-0 conditions: b's, and the shift-in, predicate and flag conditions.
+   reg c_b, c_shift, c_p, c_f;
+   // Every local has a value on every clock (none is a register); the datapath's are computed
+   // only while the engine runs.
+   {shr, kr, ak, ke, ak_wide, a_below, a_above, a_ext, a_raw} = {{LOCALS_A}}'d0;
+   {first, last, shift_out, a_zero, a_wide, f_src, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
+   f_new = {FLAG_COUNT{1'b0}};
+   conds = 32'd0;
+   pc_next = pc;
+   fetch = 1'b0;
+//@ derived_zeros
+   {c_b, c_shift, c_p, c_f} = 4'd0;
+   if (running) begin
+      shr = i_a_mod == M_SHR;
+      kr = shr ? 2'd2 - step : step;
+      // The word of A read: kr, kr + 1 (one word right) or kr - 2 (two words left).
+      ak_wide = (i_a_mod == M_WRIGHT) ? {1'b0, kr} + 3'd1 : {1'b0, kr};
+      a_below = (i_a_mod == M_WLEFT2) && (kr < 2'd2);
+      a_above = ak_wide == 3'd3;
+      ak = (i_a_mod == M_WLEFT2) ? kr - 2'd2 : ak_wide[1:0];
+      // External values, word ak of their 144-bit extension: the chain's registers
+      // sign-extended, the limits zero-extended.
+      case (i_a_src)
+//@ external_words
+      5'd22: a_ext = (ak == 2'd2) ? 48'hffff_c000_0000 : 48'd0;   // D_FLOOR = -2^126
+      default: a_ext = 48'd0;                                    // 16: zero
+      endcase
+      a_raw = a_below ? 48'd0 : a_above ? {48{fill}}
+         : (i_a_src[4] ? a_ext : rf[{i_a_src[3:0], ak}]);
+      first = step == 2'd1;
+      last = step == 2'd3;
+      ke = shr ? 2'd3 - step : step - 2'd1;
+      a_op = do_shl ? {a_q[46:0], first ? c_shift_in : shift_bit}
+         : do_shr ? {first ? a_q[47] : shift_bit, a_q[47:1]} : a_q;
+      shift_out = do_shl ? a_q[47] : (do_shr & a_q[0]);
+      b_op = b_en ? (b_q ^ {48{b_inv}}) : 48'd0;
+      sum = {1'b0, a_op} + {1'b0, b_op} + {48'd0, first ? cin0 : carry};
+      result = sum[47:0];
+      // Operand A as read is zero; does not fit in 128 bits (its bits 127..143, bits 31..47
+      // of word 2, not all equal). Both off the adder's path.
+      a_zero = (first | zero_acc) & (a_q == 48'd0);
+      a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
+      f_src = (src[0] & result[47]) | (src[1] & ~result[47]) | (src[2] & a_zero)
+         | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
+      f_new = flag_and ? (flags & {FLAG_COUNT{f_src}})
+         : flag_or ? (flags | {FLAG_COUNT{f_src}}) : {FLAG_COUNT{f_src}};
+      write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
+      // The next instruction.
+      if (i_kind == K_LOOP) pc_next = pc + 7'd1;
+      else if ((i_kind == K_OP) && last)
+         pc_next = (i_end_loop && (loop_count != 6'd1)) ? loop_pc : pc + 7'd1;
+      fetch = 1'b1;
+      if (write && i_write) rf[{i_dst, ke}] <= result;
+   end
+   if (reset) begin
+      phase <= PH_IDLE;
+      flags <= {FLAG_COUNT{1'b0}};
+   end else if (cancel) begin
+      phase <= PH_IDLE;
+   end else begin
+      case (phase)
+      PH_IDLE: if (request) begin
+         phase <= PH_PREP;
+         step <= 2'd0;
+         jlim <= jerk_limit;
+         alim <= accel_limit;
+         pc_next = PC_PREP;
+         fetch = 1'b1;
+      end
+      PH_ARMED: if (engage) begin
+         phase <= PH_RUN;
+         step <= 2'd0;
+         pc_next = PC_INIT;
+         fetch = 1'b1;
+      end
+      PH_READY: if (tick) begin
+         phase <= PH_RUN;
+         step <= 2'd0;
+         pc_next = PC_DECIDE;
+         fetch = 1'b1;
+      end
+      default: if (running) begin
+         case (i_kind)
+         K_LOOP: begin
+            loop_count <= i_count;
+            loop_pc <= pc + 7'd1;
+         end
+         K_OP: begin
+            a_q <= a_raw;
+            b_q <= rf[{i_b_reg, kr}];
+            if ((i_a_mod == M_WRIGHT) && !last) fill <= a_raw[47];
+            if (step == 2'd0) begin
+//@ derived_conditions
+               c_b = conds[i_b_cond[4:0]] ^ i_b_cond[5];
+               c_shift = conds[i_shift_in[4:0]] ^ i_shift_in[5];
+               c_p = conds[i_pred[4:0]] ^ i_pred[5];
+               c_f = conds[i_flag_cond[4:0]] ^ i_flag_cond[5];
+               c_shift_in <= c_shift;
+               c_pred <= c_p;
+               c_flag <= c_f;
+               do_shl <= i_a_mod == M_SHL;
+               do_shr <= shr;
+               b_en <= (i_b_mode == B_ADD) || (i_b_mode == B_SUB) || (i_b_mode == B_SUBONE)
+                  || (i_b_mode == B_ADDSUB) || ((i_b_mode == B_ADDIF) && c_b);
+               b_inv <= (i_b_mode == B_SUB) || (i_b_mode == B_SUBONE)
+                  || ((i_b_mode == B_ADDSUB) && !c_b);
+               cin0 <= (i_b_mode == B_SUB) || ((i_b_mode == B_ADDSUB) && !c_b);
+               flag_we <= (i_combine != 2'd0) ? ({{FLAGS}}'d1 << i_flag) : {FLAG_COUNT{1'b0}};
+               flag_and <= i_combine == C_AND;
+               flag_or <= i_combine == C_OR;
+               src <= {i_flag_src == 3'd5, i_flag_src == S_WIDE_A, i_flag_src == S_SHIFT,
+                  i_flag_src == S_ZERO_A, i_flag_src == S_NSIGN, i_flag_src == S_SIGN};
+            end else begin
+               carry <= sum[48];
+               zero_acc <= a_zero;
+               shift_bit <= shift_out;
+            end
+            if (write && i_to_snap) begin
+               case (ke)
+               2'd0: snap_reg[47:0] <= result;
+               2'd1: snap_reg[95:48] <= result;
+               default: snap_reg[D_BITS-1:96] <= result[D_BITS-97:0];
+               endcase
+            end
+            if (write && last) flags <= (flags & ~flag_we) | (flag_we & f_new);
+            if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
+            step <= last ? 2'd0 : step + 2'd1;
+         end
+         K_HALT: begin
+            // Prep done, or a decision made (or the chain found at rest).
+            if (phase == PH_PREP) phase <= PH_ARMED;
+            else if (flags[F_REST]) phase <= PH_IDLE;
+            else phase <= PH_READY;
+         end
+         default: ;
+         endcase
+      end
+      endcase
+   end
+   // One ROM read, for whichever instruction comes next.
+   if (fetch) begin
+      pc <= pc_next;
+      ir <= rom(pc_next);
+   end
+end
+
+// ---- Heading (for the limit switches), registered: the sign of v, else a, else j ---------------
+wire v_zero = v == {D_BITS{1'b0}};
+wire a_zero = a == {D_BITS{1'b0}};
+wire j_zero = j == {D_BITS{1'b0}};
+reg heading_pos_q = 1'b0;
+reg heading_neg_q = 1'b0;
+always @(posedge clock) begin
+   heading_pos_q <= !v_zero ? ~v[D_BITS-1] : (!a_zero ? ~a[D_BITS-1] : (~j[D_BITS-1] && !j_zero));
+   heading_neg_q <= !v_zero ? v[D_BITS-1] : (!a_zero ? a[D_BITS-1] : j[D_BITS-1]);
+end
+
+always @(*) begin
+   active = phase != PH_IDLE;
+   armed = phase == PH_ARMED;
+   computing = phase == PH_RUN;
+   ready = phase == PH_READY;
+   snap = snap_reg;
+   over = flags[F_EXCEEDS];
+   heading_pos = heading_pos_q;
+   heading_neg = heading_neg_q;
+   at_rest = v_zero && a_zero && j_zero;
+end

@@ -1,0 +1,89 @@
+//! The model's port structs, made from `snapgen_spec`'s port lists: one field per port of the
+//! fabric's block, with the port's name, so that the model, the fabric and the harness cannot
+//! name or size a port differently.
+//!
+//! * [`CoreInputs`], [`CoreOutputs`]: the motion core (`snapgen_core`) for one clock;
+//!   [`CoreCommand`] is its `command` section (what the executor drives) and [`CoreStatus`]
+//!   its `status` section (what the executor reads).
+//! * [`IoInputs`], [`IoOutputs`]: the I/O top's pins (`snapgen_io`) for one clock, the status
+//!   block as a [`snapgen_spec::Status`].
+
+/// A block's inputs and outputs as two structs.
+macro_rules! port_structs {
+    (
+        $inputs:ident, $outputs:ident, $what:literal;
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        #[doc = concat!("The inputs of ", $what, " for one clock.")]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct $inputs {
+            $( $( #[doc = $idoc] pub $i: $it, )* )*
+        }
+
+        #[doc = concat!("The outputs of ", $what, " after a clock edge.")]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct $outputs {
+            $( $( #[doc = $odoc] pub $o: $ot, )* )*
+        }
+    };
+}
+
+snapgen_spec::with_motion_core_ports!(
+    port_structs! { CoreInputs, CoreOutputs, "the motion core"; }
+);
+snapgen_spec::with_io_top_ports!(port_structs! { IoInputs, IoOutputs, "the I/O top"; });
+
+/// The core's `command` inputs and `status` outputs as structs of their own.
+macro_rules! core_sections {
+    (
+        clock: $cdoc:literal;
+        inputs {
+            reset { $($r:tt)* }
+            config { $($c:tt)* }
+            encoder { $($e:tt)* }
+            command { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* }
+        }
+        outputs {
+            registers { $($x:tt)* }
+            status { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* }
+            report { $($rp:tt)* }
+            debug { $($d:tt)* }
+        }
+    ) => {
+        /// The core's `command` inputs: what the executor drives (one-clock pulses and the
+        /// values they carry).
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct CoreCommand {
+            $( #[doc = $idoc] pub $i: $it, )*
+        }
+
+        /// The core's `status` outputs: what the executor and the status block read.
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct CoreStatus {
+            $( #[doc = $odoc] pub $o: $ot, )*
+        }
+
+        impl CoreInputs {
+            /// Sets the `command` inputs.
+            pub fn set_command(&mut self, c: &CoreCommand) {
+                $( self.$i = c.$i; )*
+            }
+
+            /// The `command` inputs.
+            pub fn command(&self) -> CoreCommand {
+                CoreCommand { $( $i: self.$i, )* }
+            }
+        }
+
+        impl CoreOutputs {
+            /// The `status` outputs.
+            pub fn status(&self) -> CoreStatus {
+                CoreStatus { $( $o: self.$o, )* }
+            }
+        }
+    };
+}
+
+snapgen_spec::with_motion_core_ports!(core_sections! {});
