@@ -119,7 +119,7 @@ pub fn build_plan(b: &Board, timing: &Timing, design: &Design) -> BuildPlan {
 # snapgen Vivado non-project build for the {desc}. Run: vivado -mode batch -source build.tcl
 set part {part}
 set top {top}
-read_verilog [list snapgen_io.v {top}.v]
+read_verilog [list snapgen_core.v snapgen_io.v {top}.v]
 read_xdc {top}.xdc
 synth_design -top $top -part $part
 opt_design
@@ -139,7 +139,7 @@ write_bitstream -force $top.bit
 # VIVADO points to the vivado binary (default: vivado on the PATH).
 VIVADO ?= vivado
 
-{top}.bit: snapgen_io.v {top}.v {top}.xdc build.tcl
+{top}.bit: snapgen_core.v snapgen_io.v {top}.v {top}.xdc build.tcl
 \t@command -v $(VIVADO) >/dev/null 2>&1 || {{ echo \"Vivado not found: install Vivado (AMD/Xilinx) or run make VIVADO=/path/to/vivado\" >&2; exit 1; }}
 \t$(VIVADO) -mode batch -nojournal -nolog -source build.tcl
 
@@ -152,10 +152,9 @@ clean:
         top = top,
     );
     let mut files = BTreeMap::new();
-    files.insert(
-        "snapgen_io.v".into(),
-        snapgen_hdl::verilog::io_top_verilog(design),
-    );
+    for (name, text) in snapgen_hdl::verilog::io_sources(design) {
+        files.insert(name.into(), text);
+    }
     files.insert(format!("{top}.v"), board_top_verilog(b, timing));
     files.insert(format!("{top}.xdc"), xdc(b, timing));
     files.insert("build.tcl".into(), tcl);
@@ -325,13 +324,16 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
     let plan = build_plan(b, timing, design);
     plan.write(&dir)?;
     let top = b.top_name();
+    let core_file = dir.join("snapgen_core.v");
     let full = crate::yosys::synth(
-        &[dir.join("snapgen_io.v"), dir.join(format!("{top}.v"))],
+        &[
+            core_file.clone(),
+            dir.join("snapgen_io.v"),
+            dir.join(format!("{top}.v")),
+        ],
         &top,
         &b.family,
     )?;
-    let core_file = dir.join("snapgen_core.v");
-    std::fs::write(&core_file, snapgen_hdl::verilog::motion_core_verilog())?;
     let core = crate::yosys::synth(&[core_file], snapgen_hdl::verilog::CORE_PREFIX, &b.family)?;
     let _ = std::fs::remove_dir_all(&dir);
     Ok(BoardSynth {

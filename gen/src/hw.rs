@@ -10,13 +10,13 @@ use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
 pub struct VerilogFiles {
     /// The motion core (`snapgen_core.v`).
     pub core: PathBuf,
-    /// The I/O top (`snapgen_io.v`: UART command interface, motion core, position controller, encoder, PWM).
+    /// The I/O top (`snapgen_io.v`: UART command interface, position controller, encoder, PWM, around `snapgen_core`).
     pub io_top: PathBuf,
 }
 
 /// Writes the motion core's Verilog (`snapgen_core.v`) and the I/O top of `design`
-/// (`snapgen_io.v`). Each file is self-contained (its lint waivers are written in it) and the
-/// two can be read together.
+/// (`snapgen_io.v`, which instantiates `snapgen_core`). Each file carries its own lint
+/// waivers; the I/O top needs both.
 pub fn write_verilog(out: &Path, design: &Design) -> anyhow::Result<VerilogFiles> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let core = out.join(format!("{}.v", snapgen_hdl::verilog::CORE_PREFIX));

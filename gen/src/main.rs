@@ -67,8 +67,8 @@ enum Command {
         #[arg(long)]
         svg: PathBuf,
     },
-    /// Write the motion core (snapgen_core.v) and the I/O top (snapgen_io.v) as Verilog: each
-    /// file self-contained, lint waivers written in it, the two readable together.
+    /// Write the motion core (snapgen_core.v) and the I/O top (snapgen_io.v, which instantiates
+    /// snapgen_core) as Verilog, each with its lint waivers written in it.
     Verilog {
         /// Output directory.
         #[arg(long, default_value = "out/verilog")]

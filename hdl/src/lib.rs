@@ -28,6 +28,7 @@ pub mod executor;
 pub mod frame_rx;
 pub mod input_filter;
 pub mod io_top;
+pub mod netlist;
 pub mod payload_shift;
 pub mod program_memory;
 pub mod protocol_v;

@@ -55,6 +55,17 @@ pub enum VerilogError {
     /// rust-hdl produced clock routing of a shape [`direct_clocks`] does not know.
     #[error("rust-hdl clock routing of an unknown shape survived direct_clocks")]
     ClockRouting,
+    /// rust-hdl's output has a shape the netlist passes do not know.
+    #[error("the generated Verilog has an unexpected shape: {0}")]
+    Netlist(&'static str),
+    /// The I/O top's motion core is not the motion core's design.
+    #[error("the I/O top's copy of {module} differs from snapgen_core.v's: {line}")]
+    CopyDiffers {
+        /// The module.
+        module: String,
+        /// The first line that differs.
+        line: String,
+    },
 }
 
 /// What is written next to one declaration.
@@ -215,6 +226,27 @@ fn rename(verilog: &str, prefix: &str) -> Result<String, VerilogError> {
     let name_char = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'$';
     while i < bytes.len() {
         let b = bytes[i];
+        // Comments are copied as they are (a comment's word "top" is not the design's top).
+        let comment_end = if verilog[i..].starts_with("//") {
+            Some(verilog[i..].find('\n').map_or(bytes.len(), |k| i + k))
+        } else if verilog[i..].starts_with("/*") {
+            Some(verilog[i..].find("*/").map_or(bytes.len(), |k| i + k + 2))
+        } else {
+            None
+        };
+        if let Some(end) = comment_end {
+            let comment = &verilog[i..end];
+            let line_so_far = out.rsplit('\n').next().unwrap_or("");
+            match comment.strip_prefix("// ") {
+                // `endmodule // NAME` names the module: renamed with it.
+                Some(name) if line_so_far.trim() == "endmodule" => {
+                    out.push_str(&format!("// {}", verilog_name(name.trim(), prefix)));
+                }
+                _ => out.push_str(comment),
+            }
+            i = end;
+            continue;
+        }
         // A system task (`$signed`) or a sized literal's base (`32'h50`) is not a name.
         let after_quote_or_dollar = i > 0 && matches!(bytes[i - 1], b'\'' | b'$');
         if start_char(b) && after_quote_or_dollar {
@@ -355,15 +387,21 @@ fn annotate(verilog: &str, prefix: &str, waivers: &[Waiver]) -> Result<String, V
     Ok(out)
 }
 
-/// Finishes rust-hdl's Verilog for a design: direct clocks, names under `prefix`, the waivers
-/// and hints, `` `default_nettype none`` and a header (`header`: comment lines, without `//`).
-pub fn emit(
-    raw: &str,
+/// rust-hdl's Verilog of a design under `prefix`: clocks wired directly, names renamed,
+/// register modules inlined ([`crate::netlist`]); no waivers or header yet.
+fn netlist_of(raw: &str, prefix: &str) -> Result<String, VerilogError> {
+    crate::netlist::inline_registers(&rename(&direct_clocks(raw)?, prefix)?)
+}
+
+/// A design's netlist finished: the waivers and hints, `` `default_nettype none`` and a header
+/// (`header`: comment lines, without `//`).
+fn finish(
+    body: &str,
     prefix: &str,
     header: &[String],
     waivers: &[Waiver],
 ) -> Result<String, VerilogError> {
-    let body = annotate(&rename(&direct_clocks(raw)?, prefix)?, prefix, waivers)?;
+    let body = annotate(body, prefix, waivers)?;
     let mut out = String::new();
     for h in header {
         out.push_str(&format!("// {h}\n"));
@@ -380,6 +418,18 @@ pub fn emit(
     Ok(out)
 }
 
+/// Finishes rust-hdl's Verilog for a design: direct clocks, names under `prefix`, register
+/// modules inlined, the waivers and hints, `` `default_nettype none`` and a header (`header`:
+/// comment lines, without `//`).
+pub fn emit(
+    raw: &str,
+    prefix: &str,
+    header: &[String],
+    waivers: &[Waiver],
+) -> Result<String, VerilogError> {
+    finish(&netlist_of(raw, prefix)?, prefix, header, waivers)
+}
+
 /// Any block's Verilog under `prefix` (its own tests: lint and synthesis).
 pub fn block_verilog<U: Block>(
     mut uut: U,
@@ -390,10 +440,15 @@ pub fn block_verilog<U: Block>(
     emit(&generate_verilog(&uut), prefix, &[], waivers)
 }
 
-/// The motion core's Verilog: `snapgen_core.v`, top module `snapgen_core`.
-pub fn motion_core_verilog() -> String {
+/// The motion core's rust-hdl Verilog.
+fn motion_core_raw() -> String {
     let mut uut = MotionCore::default();
     uut.connect_all();
+    generate_verilog(&uut)
+}
+
+/// The motion core's Verilog: `snapgen_core.v`, top module `snapgen_core`.
+pub fn motion_core_verilog() -> String {
     let header = [
         "snapgen motion core: tick divider, two-bank program memory, sequencer, stop unit, snap chain."
             .to_string(),
@@ -405,52 +460,66 @@ pub fn motion_core_verilog() -> String {
             1 << crate::ADDR_BITS
         ),
     ];
-    emit(
-        &generate_verilog(&uut),
-        CORE_PREFIX,
-        &header,
-        &core_waivers(),
-    )
-    .expect("the motion core's names and waivers are checked by its tests")
+    emit(&motion_core_raw(), CORE_PREFIX, &header, &core_waivers())
+        .expect("the motion core's names and waivers are checked by its tests")
 }
 
-/// The I/O top's Verilog for `design`: `snapgen_io.v`, top module `snapgen_io`. Its identity
-/// (what PING answers) carries `design.design_hash`; [`io_design`] gives a design its hash.
+/// The I/O top's Verilog for `design`: `snapgen_io.v`, top module `snapgen_io`, which
+/// instantiates `snapgen_core` (`snapgen_core.v`, [`motion_core_verilog`]): the two files
+/// together are the design, and no logic is written twice. Its identity (what PING answers)
+/// carries `design.design_hash`; [`io_design`] gives a design its hash.
 pub fn io_top_verilog(design: &Design) -> String {
     let mut uut = IoTop::new(*design);
     uut.connect_all();
     let d = design.dividers;
     let header = [
-        "snapgen I/O top: UART command interface, motion core, encoder decoder, PWM, limit switches,"
+        "snapgen I/O top: UART command interface, encoder decoder, PWM, limit switches, emergency"
             .to_string(),
-        "emergency stop, amplifier enable.".to_string(),
+        "stop, amplifier enable, around the motion core snapgen_core (snapgen_core.v: read both files)."
+            .to_string(),
         format!(
             "Built for: {} Hz clock, {} baud ({} clocks per bit), tick divider {} after reset, frame timeout {} clocks.",
             design.clock_hz, design.baud, d.uart_divisor, d.tick_div, d.frame_timeout
         ),
         format!(
-            "Design hash {:#010x}: FNV-1a (32 bits) of this file generated with the hash 0.",
+            "Design hash {:#010x}: FNV-1a (32 bits) of snapgen_core.v then this file, generated with the hash 0.",
             design.design_hash
         ),
     ];
-    emit(
-        &generate_verilog(&uut),
-        IO_PREFIX,
-        &header,
-        &io_top_waivers(),
-    )
-    .expect("the I/O top's names and waivers are checked by its tests")
+    let io = netlist_of(&generate_verilog(&uut), IO_PREFIX)
+        .and_then(|io| {
+            let core = netlist_of(&motion_core_raw(), CORE_PREFIX)?;
+            crate::netlist::use_child_design(&io, &format!("{IO_PREFIX}_core"), &core, CORE_PREFIX)
+        })
+        .and_then(|io| finish(&io, IO_PREFIX, &header, &crate::io_top::WAIVERS))
+        .expect("the I/O top's names, waivers and motion core are checked by its tests");
+    io
 }
 
-/// `design` with its hash: FNV-1a (32 bits) of its I/O top's Verilog generated with the hash
-/// 0, so a host can tell which design a board runs (docs/HDL.md).
+/// Every source file of the I/O top design for `design`: `snapgen_core.v`, then
+/// `snapgen_io.v`.
+pub fn io_sources(design: &Design) -> [(&'static str, String); 2] {
+    [
+        ("snapgen_core.v", motion_core_verilog()),
+        ("snapgen_io.v", io_top_verilog(design)),
+    ]
+}
+
+/// The I/O top design's sources as one text (what a simulator or a synthesis run reads).
+pub fn io_sources_text(design: &Design) -> String {
+    io_sources(design).map(|(_, v)| v).concat()
+}
+
+/// `design` with its hash: FNV-1a (32 bits) of its sources (`snapgen_core.v`, then
+/// `snapgen_io.v` generated with the hash 0), so a host can tell which design a board runs
+/// (docs/HDL.md).
 pub fn io_design(design: &Design) -> Design {
     let unhashed = Design {
         design_hash: 0,
         ..*design
     };
     Design {
-        design_hash: snapgen_model::device::fnv1a32(io_top_verilog(&unhashed).as_bytes()),
+        design_hash: snapgen_model::device::fnv1a32(io_sources_text(&unhashed).as_bytes()),
         ..*design
     }
 }
@@ -494,6 +563,11 @@ mod tests {
         assert_eq!(
             rename("module top$x$y(q$d); $signed(q$d) 32'h50\n", "p").unwrap(),
             "module p_x_y(q_d); $signed(q_d) 32'h50\n"
+        );
+        // Comments keep their words.
+        assert_eq!(
+            rename("// on top of top$a\ntop$a x; /* top */\n", "p").unwrap(),
+            "// on top of top$a\np_a x; /* top */\n"
         );
     }
 

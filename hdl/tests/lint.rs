@@ -83,3 +83,31 @@ fn every_block_lints_clean() {
         &snapgen_hdl::verilog::io_top_waivers(),
     );
 }
+
+/// The files `snapgen verilog` writes: `snapgen_io.v` instantiates `snapgen_core` (no module
+/// of the core is written twice), no register is a module of its own, and the two files lint
+/// clean together.
+#[test]
+fn the_io_design_is_its_two_files_with_one_core() {
+    let design = snapgen_hdl::verilog::io_design(&snapgen_hdl::io_top::default_design());
+    let [(core_name, core), (io_name, io)] = snapgen_hdl::verilog::io_sources(&design);
+    assert_eq!((core_name, io_name), ("snapgen_core.v", "snapgen_io.v"));
+    assert!(io.contains("snapgen_core core("), "the I/O top instantiates the core");
+    assert!(!io.contains("module snapgen_io_core"), "no copy of the core");
+    for text in [&core, &io] {
+        assert!(!text.contains("(d,q,clock)"), "a register module survived");
+    }
+    let dir = std::env::temp_dir().join(format!("snapgen-lint-io-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(core_name), &core).unwrap();
+    std::fs::write(dir.join(io_name), &io).unwrap();
+    let out = std::process::Command::new("verilator")
+        .args(["--lint-only", "-Wall", "--top-module", "snapgen_io"])
+        .arg(dir.join(core_name))
+        .arg(dir.join(io_name))
+        .output()
+        .expect("verilator is installed by the test command");
+    let _ = std::fs::remove_dir_all(&dir);
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && !text.contains("%Warning"), "{text}");
+}

@@ -68,7 +68,7 @@ impl VirtualBoard {
 
     /// The Verilated I/O top of `design` (built, or found in the build cache).
     pub fn fabric(design: &Design) -> Result<Self, SimError> {
-        let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+        let verilog = snapgen_hdl::verilog::io_sources_text(design);
         let built = build_io(&verilog, false)?;
         Ok(Self::with(
             design,
@@ -79,7 +79,7 @@ impl VirtualBoard {
     /// The Verilated I/O top of `design` with the device model in lockstep: every output of
     /// every clock compared ([`VirtualBoard::mismatches`]); the fabric drives the pins.
     pub fn lockstep(design: &Design) -> Result<Self, SimError> {
-        let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+        let verilog = snapgen_hdl::verilog::io_sources_text(design);
         let built = build_io(&verilog, false)?;
         Ok(Self::with(
             design,

@@ -121,7 +121,7 @@ impl ClosedLoop {
     ) -> Result<Self, LoopError> {
         let plant = Plant::new(p, f64::from(design.clock_hz), step_s)?;
         let fabric = if fabric {
-            let built = build_io(&snapgen_hdl::verilog::io_top_verilog(design), false)?;
+            let built = build_io(&snapgen_hdl::verilog::io_sources_text(design), false)?;
             Some(FabricIo::open(&built.library, None)?)
         } else {
             None

@@ -847,7 +847,7 @@ fn session(
 /// sessions on one worker thread per core; on a mismatch, the session is run again with a
 /// trace build and the waves around it are written.
 pub fn run(design: &Design, cfg: &IoCosimConfig) -> Result<IoCosimReport, SimError> {
-    let verilog = snapgen_hdl::verilog::io_top_verilog(design);
+    let verilog = snapgen_hdl::verilog::io_sources_text(design);
     let built = build_io(&verilog, false)?;
     let mut queue: VecDeque<(usize, FabricIo)> = VecDeque::new();
     for s in 0..cfg.sessions {
