@@ -2,7 +2,10 @@
 
 use std::path::{Path, PathBuf};
 
+use std::io::IsTerminal;
+
 use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
 use snapgen_model::device::Design;
 use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
 
@@ -28,10 +31,26 @@ pub fn write_verilog(out: &Path, design: &Design) -> anyhow::Result<VerilogFiles
     Ok(VerilogFiles { core, io_top })
 }
 
+/// A bar of `moves` moves on stderr when it is a terminal (hidden otherwise).
+fn move_bar(moves: usize) -> ProgressBar {
+    if std::io::stderr().is_terminal() {
+        let b = ProgressBar::new(moves as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} moves {elapsed_precise}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    }
+}
+
 /// Runs a co-simulation and prints its report; returns it.
 pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     let verilog = snapgen_hdl::verilog::motion_core_verilog();
-    let r = cosim::run(&verilog, cfg)?;
+    let bar = move_bar(cfg.moves);
+    let r = cosim::run_observed(&verilog, cfg, &|| bar.inc(1))?;
+    bar.finish_and_clear();
     println!(
         "co-simulation: {} moves ({} aborted midway, {} with a controlled stop, {} skipped), {} ticks in {} clocks compared, {} mismatches{}",
         r.moves,
@@ -71,15 +90,19 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     );
     if r.streams > 0 {
         println!(
-            "PLCopen event streams: {} played, {} commands, {} program swaps ({} of them uploading the rest of a long change); commands in Error: {}; {} ended holding a velocity (aborted after){}{}",
+            "PLCopen event streams: {} played, {} commands, {} program swaps ({} of them uploading the rest of a long change); commands in Error: {}; {} ended moving (stopped with STOP){}{}",
             r.streams,
             r.stream_commands,
             r.stream_swaps,
             r.stream_extensions,
             tally(&r.stream_errors),
-            r.streams_aborted,
+            r.streams_stopped,
             if r.streams_diverged > 0 {
-                format!("; {} diverged from the host's prediction (must be 0)", r.streams_diverged)
+                format!(
+                    "; {} diverged from the host's prediction (must be 0): {}",
+                    r.streams_diverged,
+                    r.divergences.join("; ")
+                )
             } else {
                 String::new()
             },
@@ -124,10 +147,7 @@ const BENCH_RUNS: usize = 5;
 /// Repeats the co-simulation and the model-only run and prints medians and bests: one run is
 /// at the mercy of whatever else the machine does (seen here: ±20 % between runs).
 fn print_bench(verilog: &str, cfg: &CosimConfig, first: &CosimReport) -> anyhow::Result<()> {
-    let quiet = CosimConfig {
-        progress: false,
-        ..cfg.clone()
-    };
+    let quiet = cfg.clone();
     let mut cosim_tps = vec![first.ticks_per_second()];
     for _ in 1..BENCH_RUNS {
         let again = cosim::run(verilog, &quiet)?;

@@ -541,9 +541,17 @@ enum InputError {
     #[error("{0}")]
     Board(String),
     #[error(transparent)]
-    Send(send::InputError),
+    Host(snapgen_host::session::InputError),
     #[error("{0:#}")]
     Script(anyhow::Error),
+}
+
+/// A host failure: the user's input (exit 2) or the link and the board (exit 1).
+fn failure(f: snapgen_host::session::Failure) -> anyhow::Error {
+    match f {
+        snapgen_host::session::Failure::Input(e) => InputError::Host(e).into(),
+        snapgen_host::session::Failure::Host(e) => e.into(),
+    }
 }
 
 /// The co-simulation found a difference (exit 1; the report is already printed).
@@ -778,34 +786,43 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                         m.physical().rad_per_count()
                     })
             });
-            let servo = motor.map(|m| send::ServoOptions {
-                plant: m,
-                design: servo.design(),
-                loop_hz: servo.loop_hz,
-                pwm_hz: servo.pwm_hz,
-            });
-            let opts = send::SendOptions {
-                port,
-                baud,
-                timeout: std::time::Duration::from_millis(timeout_ms),
+            let policy = snapgen_host::link::RetryPolicy {
+                timeout: timeout_ms as f64 / 1e3,
                 retries,
-                corrupt_segment,
-                stop_after: stop_after_ms.map(std::time::Duration::from_millis),
+                ..Default::default()
+            };
+            let mut session = send::open(&port, baud, policy, lsb).map_err(failure)?;
+            session.link.corrupt_segment(corrupt_segment);
+            snapgen_host::send::check_ts(&session, plan.ts).map_err(InputError::Host)?;
+            let servo = match motor {
+                Some(m) => Some(
+                    send::servo_setup(
+                        &session,
+                        &send::MotorOptions {
+                            plant: m,
+                            design: servo.design(),
+                            loop_hz: servo.loop_hz,
+                            pwm_hz: servo.pwm_hz,
+                        },
+                    )
+                    .map_err(InputError::Host)?,
+                ),
+                None => None,
+            };
+            let opts = snapgen_host::send::SendOptions {
                 ts: plan.ts,
-                position_lsb: lsb,
                 stop_decel,
                 stop_jerk,
                 reset,
                 watchdog_ms,
                 servo,
                 settle_lsb,
+                stop_after: stop_after_ms.map(|ms| ms as f64 / 1e3),
             };
-            let r = match send::send(&request, &opts) {
-                Ok(r) => r,
-                Err(send::SendFailure::Input(e)) => return Err(InputError::Send(e).into()),
-                Err(send::SendFailure::Link(e)) => return Err(e.into()),
-            };
-            print!("{}", send::describe(&r));
+            let r =
+                snapgen_host::send::send_move(&mut session, &request, &opts, &mut send::Bar::new())
+                    .map_err(failure)?;
+            print!("{}", send::describe(&r, &session.identity));
         }
         Command::Stop {
             port,
@@ -814,17 +831,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             timeout_ms,
             retries,
         } => {
-            let r = match send::stop(
+            let policy = snapgen_host::link::RetryPolicy {
+                timeout: timeout_ms as f64 / 1e3,
+                retries,
+                ..Default::default()
+            };
+            let mut session = send::open(
                 &port,
                 baud,
-                std::time::Duration::from_millis(timeout_ms),
-                retries,
-                halt,
-            ) {
-                Ok(r) => r,
-                Err(send::SendFailure::Input(e)) => return Err(InputError::Send(e).into()),
-                Err(send::SendFailure::Link(e)) => return Err(e.into()),
-            };
+                policy,
+                snapgen_model::DEFAULT_FORMAT.position_lsb,
+            )
+            .map_err(failure)?;
+            let r = snapgen_host::send::stop_axis(&mut session, halt).map_err(failure)?;
             println!(
                 "{} from {}: now {} at rest (x {:#x}, v = a = j = 0) after {} ticks{}",
                 if halt { "HALT" } else { "STOP" },

@@ -25,21 +25,21 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
-use anyhow::{bail, ensure, Context};
+use anyhow::{ensure, Context};
 use serde::{Deserialize, Serialize};
-use snapgen_host::axis::driver::{
-    power_up, run, stop_limits, Action, Event, Link, LinkError, RunOptions, RunReport,
-};
-use snapgen_host::axis::{AxisSettings, Goal, MotionCommand, Outcome};
-use snapgen_host::protocol::{Command, Reply};
+use snapgen_host::axis::{Goal, Outcome};
+use snapgen_host::driver::{Action, Event, RunOptions, RunReport};
+use snapgen_host::link::{FramedLink, Link, RetryPolicy};
+use snapgen_host::online::{play as play_script, PlayError, PlayOptions};
+use snapgen_host::serial::{session_seq, SerialTransport};
+use snapgen_host::session::Session;
 use snapgen_model::device::Design;
 use snapgen_model::timing::Timing;
-use snapgen_model::{Format, Trace, DEFAULT_FORMAT};
+use snapgen_model::{Trace, DEFAULT_FORMAT};
 use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
-use snapgen_sim::host_link::BoardLink;
+use snapgen_sim::host_link::board_link;
 
 /// A script file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -104,28 +104,14 @@ impl Script {
         }
     }
 
-    /// The stop limits: as given, or the largest deceleration and jerk of the script.
-    fn stop(&self) -> (f64, f64) {
-        let (mut d, mut j) = (0.0f64, 0.0f64);
-        for e in &self.events {
-            if let Action::Command(c) = e.action {
-                let (dc, jc) = match c {
-                    MotionCommand::MoveAbsolute {
-                        deceleration, jerk, ..
-                    }
-                    | MotionCommand::MoveVelocity {
-                        deceleration, jerk, ..
-                    }
-                    | MotionCommand::Halt { deceleration, jerk } => (deceleration, jerk),
-                };
-                d = d.max(dc);
-                j = j.max(jc);
-            }
+    /// How the host plays it.
+    fn options(&self) -> PlayOptions {
+        PlayOptions {
+            order: self.order(),
+            stop_deceleration: self.stop_deceleration,
+            stop_jerk: self.stop_jerk,
+            run: RunOptions::default(),
         }
-        (
-            self.stop_deceleration.unwrap_or(d).max(f64::MIN_POSITIVE),
-            self.stop_jerk.unwrap_or(j).max(f64::MIN_POSITIVE),
-        )
     }
 }
 
@@ -136,40 +122,6 @@ pub enum BoardKind {
     Model,
     /// The Verilated I/O top, the device model in lockstep (every output compared).
     Fabric,
-}
-
-/// A real board on a serial port: the host's clock is the wall clock.
-struct SerialLink {
-    link: crate::send::Link,
-    t0: Instant,
-    ts: f64,
-    baud: u32,
-}
-
-impl Link for SerialLink {
-    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
-        // A refusal is the board's answer, for the driver to act on (a LATE swap is planned
-        // again); only a failed link is an error here.
-        match self.link.transact(*c, false) {
-            Err(crate::send::SendError::Nak { reason, .. }) => Ok(Reply::Nak {
-                cmd: c.code(),
-                reason,
-            }),
-            r => r.map_err(|e| LinkError(e.to_string())),
-        }
-    }
-
-    fn wait(&mut self, ticks: u64) {
-        std::thread::sleep(Duration::from_secs_f64(ticks as f64 * self.ts));
-    }
-
-    fn host_ticks(&self) -> f64 {
-        self.t0.elapsed().as_secs_f64() / self.ts
-    }
-
-    fn byte_ticks(&self) -> f64 {
-        10.0 / f64::from(self.baud) / self.ts
-    }
 }
 
 /// Where to run.
@@ -196,41 +148,27 @@ pub struct Played {
     pub clocks: Option<u64>,
 }
 
-/// The board's format, read from its identity (PING): what the host plans with.
-fn board_format<L: Link>(link: &mut L) -> anyhow::Result<Format> {
-    match link
-        .ask(&Command::Ping)
-        .map_err(|e| anyhow::anyhow!("{e}"))?
-    {
-        Reply::Identity(id) => Ok(crate::send::board_format(&id, DEFAULT_FORMAT.position_lsb)?),
-        r => bail!("the board answered PING with {r:?}"),
+/// Plays `script` on the board behind `link`: a session (PING, the board's format), the stop
+/// limits, the axis powered, the run. The stop-limit rule's warnings go to stderr.
+fn play_on<L: Link>(link: L, script: &Script) -> anyhow::Result<(RunReport, L)> {
+    let mut session = Session::open(link, DEFAULT_FORMAT.position_lsb).map_err(|e| match e {
+        snapgen_host::session::Failure::Input(i) => anyhow::Error::new(i),
+        snapgen_host::session::Failure::Host(h) => anyhow::Error::new(h),
+    })?;
+    let (report, _, warnings) = play_script(&mut session, &script.events, &script.options())
+        .map_err(|e: PlayError| anyhow::Error::new(e))?;
+    for w in warnings {
+        eprintln!("warning: {w}");
     }
-}
-
-fn play_on<L: Link>(link: &mut L, script: &Script) -> anyhow::Result<RunReport> {
-    let format = board_format(link)?;
-    let (d, j) = script.stop();
-    power_up(link, stop_limits(d, j, &format))?;
-    let settings = AxisSettings {
-        format,
-        order: script.order(),
-    };
-    Ok(run(link, settings, &script.events, &RunOptions::default())?)
+    Ok((report, session.link))
 }
 
 /// Plays `script` on `target`.
 pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
     if let Some(port) = &target.port {
-        let link = crate::send::Link::open(port, target.baud, Duration::from_millis(300), 3)?;
-        let mut l = SerialLink {
-            link,
-            t0: Instant::now(),
-            ts: DEFAULT_FORMAT.ts,
-            baud: target.baud,
-        };
-        let f = board_format(&mut l)?;
-        l.ts = f.ts;
-        let report = play_on(&mut l, &script)?;
+        let t = SerialTransport::open(port, target.baud)?;
+        let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
+        let (report, _) = play_on(link, &script)?;
         return Ok(Played {
             report,
             script,
@@ -244,9 +182,8 @@ pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
         BoardKind::Model => VirtualBoard::model(&design),
         BoardKind::Fabric => VirtualBoard::lockstep(&design)?,
     };
-    let mut link = BoardLink::new(board);
-    let report = play_on(&mut link, &script)?;
-    let b = link.board();
+    let (report, link) = play_on(board_link(board), &script)?;
+    let b = link.transport().board();
     let fabric = target.board == BoardKind::Fabric;
     Ok(Played {
         report,
@@ -552,6 +489,7 @@ pub fn write_svg(p: &Played, title: &str, path: &Path) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use snapgen_host::axis::MotionCommand;
 
     /// The script format's example in docs/ONLINE.md parses, passes the checks, and holds
     /// every kind of event.

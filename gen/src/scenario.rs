@@ -14,8 +14,8 @@
 //!   numbers; ours are the standard's example scaled down (positions 6 and 10 mm, velocities
 //!   150 and 100 mm/s), case (a) followed by a return to 0 and case (b).
 
-use snapgen_host::axis::driver::{Action, Event};
 use snapgen_host::axis::{BufferMode, MotionCommand};
+use snapgen_host::driver::{Action, Event};
 
 use crate::online::Script;
 

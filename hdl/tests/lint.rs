@@ -92,8 +92,14 @@ fn the_io_design_is_its_two_files_with_one_core() {
     let design = snapgen_hdl::verilog::io_design(&snapgen_hdl::io_top::default_design());
     let [(core_name, core), (io_name, io)] = snapgen_hdl::verilog::io_sources(&design);
     assert_eq!((core_name, io_name), ("snapgen_core.v", "snapgen_io.v"));
-    assert!(io.contains("snapgen_core core("), "the I/O top instantiates the core");
-    assert!(!io.contains("module snapgen_io_core"), "no copy of the core");
+    assert!(
+        io.contains("snapgen_core core("),
+        "the I/O top instantiates the core"
+    );
+    assert!(
+        !io.contains("module snapgen_io_core"),
+        "no copy of the core"
+    );
     for text in [&core, &io] {
         assert!(!text.contains("(d,q,clock)"), "a register module survived");
     }

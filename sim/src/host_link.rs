@@ -1,34 +1,26 @@
-//! The host's [`Link`] to a [`VirtualBoard`]: commands go over the board's UART at its baud
-//! rate, byte by byte, and time is the board's own (its clocks), so a latency measured here is
-//! the one the design's UART gives, to the clock.
+//! A [`Transport`] to a [`VirtualBoard`]: bytes go over the board's UART at its baud rate,
+//! and time is the board's own (its clocks), so a latency measured here is the one the
+//! design's UART gives, to the clock. The host's [`FramedLink`] over it is the same code, with
+//! the same retry policy, as over a serial port.
 
-use snapgen_host::axis::driver::{Link, LinkError};
-use snapgen_host::protocol::{Command, Decoded, Decoder, Reply};
+use snapgen_host::link::{FramedLink, LinkError, RetryPolicy, Transport};
 
 use crate::board::VirtualBoard;
 
 /// Clocks run between looks at the board's output.
 const CHUNK: u64 = 32;
 
-/// A link to a virtual board.
-pub struct BoardLink {
+/// A virtual board as a byte medium.
+pub struct BoardTransport {
     board: VirtualBoard,
-    decoder: Decoder,
-    seq: u8,
-    /// Clocks a reply may take (a second of board time).
-    timeout: u64,
+    clock_hz: f64,
 }
 
-impl BoardLink {
-    /// A link to `board`.
+impl BoardTransport {
+    /// `board` as a transport.
     pub fn new(board: VirtualBoard) -> Self {
-        let timeout = u64::from(board.design().clock_hz);
-        BoardLink {
-            board,
-            decoder: Decoder::new(),
-            seq: 0,
-            timeout,
-        }
+        let clock_hz = f64::from(board.design().clock_hz);
+        BoardTransport { board, clock_hz }
     }
 
     /// The board.
@@ -41,46 +33,48 @@ impl BoardLink {
         &mut self.board
     }
 
-    fn tick_clocks(&self) -> u64 {
-        u64::from(self.board.design().dividers.tick_div) + 1
+    fn clocks_of(&self, seconds: f64) -> u64 {
+        (seconds.max(0.0) * self.clock_hz).round() as u64
     }
 }
 
-impl Link for BoardLink {
-    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
-        self.seq = self.seq.wrapping_add(1).max(1);
-        let seq = self.seq;
-        let format = self.board.design().format;
-        self.board.receive(&c.to_frame(seq, &format).to_bytes());
-        let mut waited = 0;
-        while waited < self.timeout {
-            self.board.run(CHUNK);
-            waited += CHUNK;
-            for b in self.board.take_output() {
-                if let Some(Decoded::Frame(f)) = self.decoder.push(b) {
-                    if f.seq == seq {
-                        if let Some(r) = Reply::from_frame(&f) {
-                            return Ok(r);
-                        }
-                    }
-                }
+impl Transport for BoardTransport {
+    fn write(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.board.receive(bytes);
+        Ok(())
+    }
+
+    fn read(&mut self, wait: f64, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        let mut left = self.clocks_of(wait).max(1);
+        while left > 0 {
+            let n = left.min(CHUNK);
+            self.board.run(n);
+            left -= n;
+            let got = self.board.take_output();
+            if !got.is_empty() {
+                out.extend_from_slice(&got);
+                return Ok(());
             }
         }
-        Err(LinkError(format!(
-            "no reply to {c:?} within {} clocks",
-            self.timeout
-        )))
+        Ok(())
     }
 
-    fn wait(&mut self, ticks: u64) {
-        self.board.run(ticks * self.tick_clocks());
+    fn now(&self) -> f64 {
+        self.board.clocks() as f64 / self.clock_hz
     }
 
-    fn byte_ticks(&self) -> f64 {
-        10.0 * f64::from(self.board.design().dividers.uart_divisor) / self.tick_clocks() as f64
+    fn sleep(&mut self, seconds: f64) {
+        let n = self.clocks_of(seconds);
+        self.board.run(n);
     }
 
-    fn host_ticks(&self) -> f64 {
-        self.board.clocks() as f64 / self.tick_clocks() as f64
+    fn byte_time(&self) -> f64 {
+        10.0 * f64::from(self.board.design().dividers.uart_divisor) / self.clock_hz
     }
+}
+
+/// The host's link to `board`: the framed protocol with the one retry policy, sequence
+/// numbers from 0 (a simulation repeats).
+pub fn board_link(board: VirtualBoard) -> FramedLink<BoardTransport> {
+    FramedLink::new(BoardTransport::new(board), RetryPolicy::default(), 0)
 }

@@ -3,16 +3,18 @@
 //! poll against the host's prediction by the driver, and here against an independent tick by
 //! tick replay of what the board played.
 
-use snapgen_host::axis::driver::{
-    power_up, run, stop_limits, Action, Event, RunOptions, RunReport,
-};
-use snapgen_host::axis::{AxisErrorId, AxisSettings, BufferMode, Goal, MotionCommand, Outcome};
+use snapgen_host::axis::{AxisErrorId, BufferMode, Goal, MotionCommand, Outcome};
+use snapgen_host::driver::{Action, Event, RunOptions, RunReport};
+use snapgen_host::link::{FramedLink, Link, LinkError};
+use snapgen_host::online::{play as play_script, PlayOptions};
+use snapgen_host::protocol::{Command, Reply, Status};
+use snapgen_host::session::Session;
 use snapgen_model::device::Design;
 use snapgen_model::timing::Timing;
 use snapgen_model::{ChainState, DEFAULT_FORMAT};
 use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
-use snapgen_sim::host_link::BoardLink;
+use snapgen_sim::host_link::{board_link, BoardTransport};
 
 /// The co-simulation design (1 MHz clock, 16 clocks a tick, 125 000 baud): fast to simulate,
 /// with the same ratio of link time to motion time as a real board within a few times.
@@ -52,26 +54,24 @@ fn at(ms: f64, c: MotionCommand) -> Event {
 }
 
 fn play(script: &[Event], order: OnlineOrder) -> RunReport {
-    play_on(
-        &mut BoardLink::new(VirtualBoard::model(&design())),
-        script,
+    play_on(VirtualBoard::model(&design()), script, order).0
+}
+
+type BoardSession = Session<FramedLink<BoardTransport>>;
+
+/// Plays `script` on `board` as every host does (`snapgen_host::online::play`: PING, the
+/// stop limits written, POWER 1, the driver's run); the session after it.
+fn play_on(board: VirtualBoard, script: &[Event], order: OnlineOrder) -> (RunReport, BoardSession) {
+    let lsb = board.design().format.position_lsb;
+    let mut session = Session::open(board_link(board), lsb).unwrap();
+    let opts = PlayOptions {
         order,
-    )
-}
-
-/// The board's format: its Ts from its clock and tick divider.
-fn format_of(d: &Design) -> snapgen_model::Format {
-    snapgen_model::Format {
-        ts: d.ts(),
-        ..d.format
-    }
-}
-
-fn play_on(link: &mut BoardLink, script: &[Event], order: OnlineOrder) -> RunReport {
-    let f = format_of(link.board().design());
-    power_up(link, stop_limits(3000.0, 500_000.0, &f)).unwrap();
-    let settings = AxisSettings { format: f, order };
-    run(link, settings, script, &RunOptions::default()).unwrap()
+        stop_deceleration: Some(3000.0),
+        stop_jerk: Some(500_000.0),
+        run: RunOptions::default(),
+    };
+    let (report, _, _) = play_script(&mut session, script, &opts).unwrap();
+    (report, session)
 }
 
 fn outcomes(r: &RunReport) -> Vec<Outcome> {
@@ -373,11 +373,7 @@ fn latency_is_tens_of_ms_at_115200_and_a_few_at_3_mbaud() {
     ];
     for (baud, most_ms) in [(115_200, 100.0), (3_000_000, 5.0)] {
         let d = real_design(baud);
-        let r = play_on(
-            &mut BoardLink::new(VirtualBoard::model(&d)),
-            &script,
-            OnlineOrder::Three,
-        );
+        let r = play_on(VirtualBoard::model(&d), &script, OnlineOrder::Three).0;
         assert_eq!(outcomes(&r)[1], Outcome::Done);
         assert_eq!(r.swaps.len(), 2);
         for s in &r.swaps {
@@ -408,11 +404,7 @@ fn an_override_takes_effect_within_tens_of_ms_at_115200_and_a_few_at_921600() {
     ];
     for (baud, most_ms) in [(115_200, 50.0), (921_600, 12.0)] {
         let d = real_design(baud);
-        let r = play_on(
-            &mut BoardLink::new(VirtualBoard::model(&d)),
-            &script,
-            OnlineOrder::Three,
-        );
+        let r = play_on(VirtualBoard::model(&d), &script, OnlineOrder::Three).0;
         assert_eq!(outcomes(&r), [Outcome::Done]);
         assert!(r.refused_overrides.is_empty());
         let overrides: Vec<_> = r.swaps.iter().filter(|s| s.events[0] > 0).collect();
@@ -429,6 +421,92 @@ fn an_override_takes_effect_within_tens_of_ms_at_115200_and_a_few_at_921600() {
     }
 }
 
+/// A link that measures the longest silence between the end of one request and the start
+/// of the next (the host's clock).
+struct GapLink<L: Link> {
+    inner: L,
+    last_end: Option<f64>,
+    longest: f64,
+}
+
+impl<L: Link> Link for GapLink<L> {
+    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
+        if let Some(t) = self.last_end {
+            self.longest = self.longest.max(self.inner.now() - t);
+        }
+        let r = self.inner.ask(c);
+        self.last_end = Some(self.inner.now());
+        r
+    }
+    fn set_format(&mut self, f: &snapgen_model::Format) {
+        self.inner.set_format(f)
+    }
+    fn take_telemetry(&mut self) -> Option<Status> {
+        self.inner.take_telemetry()
+    }
+    fn now(&self) -> f64 {
+        self.inner.now()
+    }
+    fn wait(&mut self, s: f64) {
+        self.inner.wait(s)
+    }
+    fn byte_time(&self) -> f64 {
+        self.inner.byte_time()
+    }
+}
+
+/// The driver feeds the board's watchdog: it is never silent longer than its poll period,
+/// not even while it waits for an armed swap before a change (it once slept until the swap's
+/// tick, which on a slow tick — Ts = 1 ms, where a swap's lead of some hundred ticks is
+/// tenths of a second — let a 1 s watchdog expire mid-move: ErrorStop).
+#[test]
+fn the_driver_is_never_silent_longer_than_its_poll_period() {
+    let feed = |ms: f64, k: f64| Event {
+        at_ms: ms,
+        at_position: None,
+        action: Action::Override { r#override: k },
+    };
+    let script = [
+        at(0.0, mv(100.0, 200.0, BufferMode::Aborting)),
+        feed(40.0, 0.5),
+        feed(60.0, 1.5),
+        feed(300.0, 0.8),
+        feed(310.0, 1.2),
+    ];
+    let d = Design::from_timing(
+        &DEFAULT_FORMAT,
+        &Timing {
+            clock_hz: 1_000_000,
+            baud: 125_000,
+            ts: 1e-3,
+        },
+    )
+    .unwrap();
+    let link = GapLink {
+        inner: board_link(VirtualBoard::model(&d)),
+        last_end: None,
+        longest: 0.0,
+    };
+    let mut session = Session::open(link, d.format.position_lsb).unwrap();
+    let opts = PlayOptions {
+        order: OnlineOrder::Three,
+        stop_deceleration: Some(3000.0),
+        stop_jerk: Some(500_000.0),
+        run: RunOptions::default(),
+    };
+    let (r, _, _) = play_script(&mut session, &script, &opts).unwrap();
+    assert_eq!(outcomes(&r), [Outcome::Done]);
+    let poll_s = opts.run.poll_ms * 1e-3;
+    let longest = session.link.longest;
+    // One tick of rounding: waits are whole ticks.
+    assert!(
+        longest <= poll_s + d.ts() * 1.01,
+        "silent for {:.1} ms (poll period {} ms)",
+        longest * 1e3,
+        opts.run.poll_ms
+    );
+}
+
 /// The same host axis on the Verilated I/O top with the device model in lockstep: 0
 /// mismatches; the same run with one output bit flipped on one clock is caught.
 #[test]
@@ -443,23 +521,23 @@ fn on_the_fabric_every_output_matches_and_a_flipped_bit_is_caught() {
         },
     ];
     let d = design();
-    let mut link = BoardLink::new(VirtualBoard::lockstep(&d).unwrap());
-    let r = play_on(&mut link, &script, OnlineOrder::Three);
-    assert_eq!(
-        link.board().mismatches(),
-        0,
-        "{:?}",
-        link.board().first_mismatch()
+    let (r, s) = play_on(
+        VirtualBoard::lockstep(&d).unwrap(),
+        &script,
+        OnlineOrder::Three,
     );
+    let board = s.link.transport().board();
+    assert_eq!(board.mismatches(), 0, "{:?}", board.first_mismatch());
     assert_eq!(outcomes(&r), [Outcome::Done, Outcome::Done]);
     lands_on(&r, 12.0);
 
-    let mut link = BoardLink::new(VirtualBoard::lockstep(&d).unwrap());
+    let mut board = VirtualBoard::lockstep(&d).unwrap();
     let pin = snapgen_sim::io::IoSignal::all().next().unwrap();
-    link.board_mut().inject_fault(5_000, pin, 0);
-    let _ = play_on(&mut link, &script, OnlineOrder::Three);
-    assert_eq!(link.board().mismatches(), 1);
-    assert_eq!(link.board().first_mismatch().unwrap().clock, 5_000);
+    board.inject_fault(5_000, pin, 0);
+    let (_, s) = play_on(board, &script, OnlineOrder::Three);
+    let board = s.link.transport().board();
+    assert_eq!(board.mismatches(), 1);
+    assert_eq!(board.first_mismatch().unwrap().clock, 5_000);
 }
 
 /// Random scripts on the model board: random moves with random buffer modes, velocities,
@@ -573,11 +651,7 @@ fn a_change_the_link_cannot_keep_up_with_is_refused_whole() {
     );
     // At 3 Mbaud on the default board the rest goes up in time.
     let d = real_design(3_000_000);
-    let r = play_on(
-        &mut BoardLink::new(VirtualBoard::model(&d)),
-        &script,
-        OnlineOrder::Three,
-    );
+    let r = play_on(VirtualBoard::model(&d), &script, OnlineOrder::Three).0;
     assert!(
         outcomes(&r).iter().all(|o| *o == Outcome::Done),
         "{:?}",

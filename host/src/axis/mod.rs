@@ -23,11 +23,10 @@
 //!   scaled by `k`; at `k = 0` the axis stops on its path with the moves' deceleration and
 //!   the command stays Busy, to go on when the override rises again.
 //!
-//! The pure part (this module and [`compose`]) does no I/O; [`driver`] runs it over any
-//! [`driver::Link`] (the device model, the Verilated board, a serial port).
+//! This module and [`compose`] do no I/O; [`crate::driver`] runs the axis over any
+//! [`crate::link::Link`] (the device model, the Verilated board, a serial port).
 
 pub mod compose;
-pub mod driver;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

@@ -1,159 +1,32 @@
 //! PLCopen event streams on the lockstep core: random scripts of MC_MoveAbsolute (every
 //! buffer mode, blends among them), MC_MoveVelocity, MC_Halt and feed-override changes at
 //! random ticks — mid-jerk, mid-acceleration, at cruise, at rest — played by the host's own
-//! driver (`snapgen_host::axis::driver::run`): it plans every change from the exact state at
-//! a swap tick ahead of the link's latency, uploads it, arms the swap and compares every state
-//! it reads with its prediction. The link here is the core's own ports, one clock per segment
-//! written, with the wire time of a UART at the stream's baud rate passing on the core as
-//! idle clocks, so the host leads its swaps as it does over a real link. Fabric and model
-//! are compared on every clock meanwhile; each stream ends at rest where its timeline says.
+//! code (`snapgen_host::online::play`: a session opened with PING, the stop limits written
+//! by the one rule, POWER 1, then the driver, which plans every change from the exact state
+//! at a swap tick ahead of the link's latency, uploads it, arms the swap and compares every
+//! state it reads with its prediction). The link is the board's executor clocked beside the
+//! core ([`ExecutorLink`]), at a UART's wire time for the stream's baud rate, so the host
+//! leads its swaps as over a real link. Fabric and model are compared on every clock
+//! meanwhile; a stream that ends moving is stopped with the board's STOP.
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
-use snapgen_host::axis::driver::{
-    run, Action, Event, Link, LinkError, RunError, RunOptions, RunReport,
-};
-use snapgen_host::axis::{AxisSettings, BufferMode, MotionCommand, Outcome};
-use snapgen_host::protocol::{Command, Reason, Reply, StateReply};
+use snapgen_host::axis::{BufferMode, MotionCommand, Outcome};
+use snapgen_host::driver::{Action, Event, RunError, RunOptions, RunReport};
+use snapgen_host::link::Link;
+use snapgen_host::online::{play, PlayError, PlayOptions};
+use snapgen_host::protocol::Command;
+use snapgen_host::session::Session;
 use snapgen_model::{CoreInputs, Format};
 use snapgen_plan::online::OnlineOrder;
 
-use super::{CosimReport, Lockstep, Mismatch, BATCH};
+use super::executor_link::ExecutorLink;
+use super::lockstep::Lockstep;
+use super::{CosimReport, Mismatch};
 use crate::moves::{log_uniform, MoveSpec};
 
-/// The host's link to the lockstep core (module documentation).
-struct CoreLink<'l> {
-    ls: &'l mut Lockstep,
-    idle: CoreInputs,
-    /// Clocks per tick.
-    per_tick: u64,
-    /// Board ticks a byte takes on the simulated wire.
-    byte_ticks: f64,
-    /// The format frames are encoded with (their lengths give the wire time).
-    format: Format,
-    /// Wire time not yet passed on the core (a fraction of a tick).
-    owed: f64,
-    /// The first mismatch: every request fails after it.
-    mismatch: Option<Mismatch>,
-    /// Timely SWAP_ATs the core did not arm (must be 0).
-    not_armed: usize,
-}
-
-impl CoreLink<'_> {
-    /// Lets `ticks` (real) ticks pass on the core, idle.
-    fn pass(&mut self, ticks: f64) {
-        self.owed += ticks;
-        let whole = self.owed.floor();
-        self.owed -= whole;
-        let mut left = whole as u64 * self.per_tick;
-        while left > 0 && self.mismatch.is_none() {
-            let k = left.min(BATCH);
-            if let Err(m) = self.ls.drive(&self.idle, k) {
-                self.mismatch = Some(m);
-            }
-            left -= k;
-        }
-    }
-
-    /// One clock with inputs `i`.
-    fn clock(&mut self, i: &CoreInputs) {
-        if self.mismatch.is_none() {
-            if let Err(m) = self.ls.drive(i, 1) {
-                self.mismatch = Some(m);
-            }
-        }
-    }
-}
-
-impl Link for CoreLink<'_> {
-    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
-        let ack = Reply::Ack { cmd: c.code() };
-        let reply = match *c {
-            Command::ReadState => {
-                let o = self.ls.side.model.outputs();
-                Reply::State(StateReply {
-                    ticks: o.ticks,
-                    x: o.x,
-                    v: o.v,
-                    a: o.a,
-                    j: o.j,
-                })
-            }
-            Command::LoadSegment { index, segment } => {
-                self.clock(&CoreInputs {
-                    write_enable: true,
-                    write_address: index,
-                    write_ticks: segment.ticks,
-                    write_snap: segment.snap,
-                    ..self.idle
-                });
-                ack
-            }
-            Command::Commit { count } => {
-                self.clock(&CoreInputs {
-                    count_enable: true,
-                    count_value: count,
-                    ..self.idle
-                });
-                ack
-            }
-            Command::SwapAt { tick } => {
-                // The executor's rule (docs/PROTOCOL.md): five ticks or more ahead of the time
-                // base, else LATE and nothing changes.
-                let now = self.ls.side.model.outputs().ticks;
-                if tick < now + 5 {
-                    Reply::Nak {
-                        cmd: c.code(),
-                        reason: Reason::Late,
-                    }
-                } else {
-                    self.clock(&CoreInputs {
-                        swap: true,
-                        swap_last: tick.wrapping_sub(1) as u32,
-                        ..self.idle
-                    });
-                    // Past the input register.
-                    let idle = self.idle;
-                    self.clock(&idle);
-                    if !self.ls.side.model.outputs().swap_pending {
-                        self.not_armed += 1;
-                    }
-                    ack
-                }
-            }
-            Command::Stop => {
-                // Only on a divergence (which fails the stream): abort at once.
-                self.clock(&CoreInputs {
-                    abort_move: true,
-                    ..self.idle
-                });
-                let idle = self.idle;
-                self.clock(&idle);
-                ack
-            }
-            _ => return Err(LinkError(format!("{c:?}: not a request of the core link"))),
-        };
-        let bytes =
-            c.to_frame(0, &self.format).to_bytes().len() + reply.to_frame(0).to_bytes().len();
-        self.pass(bytes as f64 * self.byte_ticks);
-        match self.mismatch {
-            Some(_) => Err(LinkError("the fabric and the model differ".into())),
-            None => Ok(reply),
-        }
-    }
-
-    fn wait(&mut self, ticks: u64) {
-        self.pass(ticks as f64);
-    }
-
-    fn host_ticks(&self) -> f64 {
-        self.ls.side.model.outputs().ticks as f64 + self.owed
-    }
-
-    fn byte_ticks(&self) -> f64 {
-        self.byte_ticks
-    }
-}
+/// Longest a stream's closing STOP may take (clocks) before the core is aborted.
+const MAX_CLOSING_STOP_CLOCKS: u64 = 4_000_000;
 
 /// Baud rates the streams' simulated links run at: mostly fast, now and then 115 200.
 const BAUDS: [f64; 4] = [3e6, 3e6, 921_600.0, 115_200.0];
@@ -241,7 +114,8 @@ fn script(rng: &mut StdRng, f: &Format, n: u8, home: f64) -> Vec<Event> {
 }
 
 /// Plays a stream of `spec.stream` random PLCopen events on the lockstep core through the
-/// host's driver (module documentation), from the state at rest the session is in.
+/// host's code and the board's executor (module documentation), from the state at rest the
+/// session is in; at its end the core is at rest again.
 pub(super) fn stream(
     ls: &mut Lockstep,
     spec: &MoveSpec,
@@ -250,7 +124,9 @@ pub(super) fn stream(
 ) -> Result<(), Mismatch> {
     let mut rng = StdRng::seed_from_u64(spec.replan_seed);
     let f = Format::with_ts(spec.ts);
-    let home = f.position_physical(ls.side.model.chain().x);
+    // POWER 1 loads the reference at the encoder's cell, where the core stands.
+    let cell = ls.side.model.chain().x >> snapgen_model::FRAC_BITS;
+    let home = cell as f64 * f.position_lsb;
     let events = script(&mut rng, &f, spec.stream, home);
     let order = if rng.gen_bool(0.75) {
         OnlineOrder::Three
@@ -258,55 +134,80 @@ pub(super) fn stream(
         OnlineOrder::Two
     };
     let baud = BAUDS[rng.gen_range(0..BAUDS.len())];
-    let per_tick = u64::from(idle.tick_div) + 1;
-    let mut link = CoreLink {
-        ls,
-        idle: *idle,
-        per_tick,
-        byte_ticks: 10.0 / baud / spec.ts,
-        format: f,
-        owed: 0.0,
-        mismatch: None,
-        not_armed: 0,
+    let link = ExecutorLink::new(ls, &f, spec.tick_div, baud);
+    let opts = PlayOptions {
+        order,
+        stop_deceleration: None,
+        stop_jerk: None,
+        run: RunOptions {
+            // A poll every 100 ticks; the run ends when the axis has settled after the last
+            // event (the stream's last events bring it to rest), at the latest 10^6 ticks on.
+            poll_ms: 100.0 * spec.ts * 1e3,
+            settle_ms: 1e6 * spec.ts * 1e3,
+        },
     };
-    let opts = RunOptions {
-        // A poll every 100 ticks; the run ends when the axis has settled after the last
-        // event (the stream's last events bring it to rest), at the latest 10^6 ticks on.
-        poll_ms: 100.0 * spec.ts * 1e3,
-        settle_ms: 1e6 * spec.ts * 1e3,
+    let mut session = match Session::open(link, f.position_lsb) {
+        Ok(s) => s,
+        Err(e) => {
+            // Only a mismatch fails PING on this link.
+            *report.streams_failed.entry(format!("{e}")).or_default() += 1;
+            return Ok(());
+        }
     };
-    let result = run(&mut link, AxisSettings { format: f, order }, &events, &opts);
-    if let Some(m) = link.mismatch.take() {
+    let result = play(&mut session, &events, &opts);
+    let link = &mut session.link;
+    if let Some(m) = link.take_mismatch() {
         return Err(m);
     }
-    report.swaps_not_armed += link.not_armed;
     report.streams += 1;
     match result {
-        Ok(r) => tally(&r, report),
-        Err(RunError::Diverged { .. }) => report.streams_diverged += 1,
+        Ok((r, _, _)) => tally(&r, report),
+        Err(PlayError::Run(e @ RunError::Diverged { .. })) => {
+            let ex = link.executor_outputs();
+            let ls = link.lockstep();
+            report.streams_diverged += 1;
+            report.divergences.push(format!(
+                "session {} move {}: {e} (axis {:?}, error {:?})",
+                ls.session, ls.move_index, ex.state, ex.error
+            ));
+        }
         Err(e) => {
-            let kind = format!("{e}");
-            *report.streams_failed.entry(kind).or_default() += 1;
+            *report.streams_failed.entry(format!("{e}")).or_default() += 1;
         }
     }
-    // Wherever the stream ended, the core ends it at rest: a run that ended on a held
-    // velocity or failed is stopped here.
-    if !ls_at_rest(link.ls) {
-        link.ls.drive(
+    // A stream that ended moving (a velocity held, a failed run) is stopped with the board's
+    // STOP, as a host does, and run to rest; the core is aborted (past the executor) only if
+    // that stop does not end.
+    if !at_rest(link.lockstep()) {
+        report.streams_stopped += 1;
+        let _ = link.ask(&Command::Stop);
+        let per_tick = u64::from(spec.tick_div) + 1;
+        let mut left = MAX_CLOSING_STOP_CLOCKS / (100 * per_tick);
+        while !at_rest(link.lockstep()) && left > 0 {
+            link.wait(100.0 * spec.ts);
+            left -= 1;
+        }
+    }
+    if let Some(m) = link.take_mismatch() {
+        return Err(m);
+    }
+    let ls = link.lockstep();
+    if !at_rest(ls) {
+        ls.drive(
             &CoreInputs {
                 abort_move: true,
                 ..*idle
             },
             1,
         )?;
-        link.ls.drive(idle, 2)?;
-        report.streams_aborted += 1;
+        ls.drive(idle, 2)?;
     }
     Ok(())
 }
 
-fn ls_at_rest(ls: &Lockstep) -> bool {
-    ls.side.model.chain().is_at_rest() && !ls.side.model.busy()
+fn at_rest(ls: &Lockstep) -> bool {
+    let m = &ls.side.model;
+    m.chain().is_at_rest() && !m.busy() && !m.stopping()
 }
 
 /// Adds a finished run to the report: its swaps (replans and extensions), commands and their

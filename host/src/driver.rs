@@ -10,30 +10,12 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::axis::compose::{Refusal, Request};
+use crate::axis::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
+use crate::link::{Link, LinkError};
 use crate::protocol::{Command, Reason, Reply, StateReply};
 use snapgen_model::chain::ChainState;
-
-use super::compose::{Refusal, Request};
-use super::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
 use snapgen_model::program::Program;
-
-/// A board the host talks to.
-pub trait Link {
-    /// Sends `c` and returns the board's reply (a lost reply is retried inside).
-    fn ask(&mut self, c: &Command) -> Result<Reply, LinkError>;
-    /// Lets about `ticks` board ticks pass.
-    fn wait(&mut self, ticks: u64);
-    /// The host's clock in board ticks (a virtual board: its clocks over the tick divider;
-    /// a serial port: wall time over Ts).
-    fn host_ticks(&self) -> f64;
-    /// Board ticks one byte takes on the wire (10 bits at the baud rate).
-    fn byte_ticks(&self) -> f64;
-}
-
-/// The link failed.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("{0}")]
-pub struct LinkError(pub String);
 
 /// What a script event does.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -239,6 +221,8 @@ const LATE_TRIES: u32 = 8;
 
 struct Runner<'l, L: Link> {
     link: &'l mut L,
+    /// The board's tick (s): the driver counts in ticks, the link in seconds.
+    ts: f64,
     axis: HostAxis,
     checks: u64,
     last: StateReply,
@@ -268,13 +252,28 @@ struct Runner<'l, L: Link> {
 }
 
 impl<L: Link> Runner<'_, L> {
+    /// The host's clock in board ticks.
+    fn host_ticks(&self) -> f64 {
+        self.link.now() / self.ts
+    }
+
+    /// Board ticks one byte takes on the wire.
+    fn byte_ticks(&self) -> f64 {
+        self.link.byte_time() / self.ts
+    }
+
+    /// Lets `ticks` board ticks pass.
+    fn wait_ticks(&mut self, ticks: u64) {
+        self.link.wait(ticks as f64 * self.ts);
+    }
+
     /// READ_STATE, compared with the prediction; the axis's outcomes updated.
     fn poll(&mut self) -> Result<StateReply, RunError> {
-        let t0 = self.link.host_ticks();
+        let t0 = self.host_ticks();
         let s = read_state(self.link)?;
-        self.polled = self.link.host_ticks();
-        self.reply_wire = self.bytes.state as f64 * self.link.byte_ticks();
-        let wire = self.bytes.read as f64 * self.link.byte_ticks();
+        self.polled = self.host_ticks();
+        self.reply_wire = self.bytes.state as f64 * self.byte_ticks();
+        let wire = self.bytes.read as f64 * self.byte_ticks();
         self.overhead = self.overhead.max(self.polled - t0 - wire);
         let want = self
             .axis
@@ -323,10 +322,12 @@ impl<L: Link> Runner<'_, L> {
             // An armed swap must have passed before the standby bank is written again.
             if let Some(t) = self.armed {
                 // Waited for from the board's tick now (its last reply has come since), then
-                // seen a round trip later, as [`Runner::seen_ticks`] has it.
+                // seen a round trip later, as [`Runner::seen_ticks`] has it; a poll at least
+                // every poll period meanwhile (the watchdog's food: a swap armed seconds
+                // ahead on a slow tick once let it expire).
                 let now = self.board_now();
                 if now < t {
-                    self.link.wait(t - now);
+                    self.wait_ticks((t - now).min(self.poll_ticks));
                 }
                 self.poll()?;
                 continue;
@@ -336,7 +337,7 @@ impl<L: Link> Runner<'_, L> {
                 // which found the change due) dates the board's tick.
                 self.poll()?;
             }
-            let t0 = self.link.host_ticks();
+            let t0 = self.host_ticks();
             let now = self.board_now();
             let f = self.axis.settings.format;
             // The first upload carries the change's first segments only, as few as let the
@@ -345,8 +346,13 @@ impl<L: Link> Runner<'_, L> {
             // up as extensions while the first part plays. A head that keeps the board going
             // but is not roomy is taken when no larger one keeps it going.
             let mut found = None;
-            let mut fallback: Option<(u64, super::Change, Vec<(Request, Refusal)>, usize, bool)> =
-                None;
+            let mut fallback: Option<(
+                u64,
+                crate::axis::Change,
+                Vec<(Request, Refusal)>,
+                usize,
+                bool,
+            )> = None;
             for first in HEADS {
                 let first = first.min(f.max_segments);
                 // The lead is the head's upload ([`Runner::lead`]) and the planning time seen;
@@ -392,7 +398,7 @@ impl<L: Link> Runner<'_, L> {
             // board's clock stands still meanwhile): the longest seen goes into later leads.
             self.planning = self
                 .planning
-                .max((self.link.host_ticks() - t0).max(0.0).ceil() as u64);
+                .max((self.host_ticks() - t0).max(0.0).ceil() as u64);
             if self.needs_extension() && !self.extension_fits(at) {
                 // The board would play out what it holds before this swap, or before the rest
                 // of the running change could follow a NAK LATE of it (taken, the change makes
@@ -465,7 +471,7 @@ impl<L: Link> Runner<'_, L> {
             what,
             detail: reason.name().to_string(),
         };
-        let t0 = self.link.host_ticks();
+        let t0 = self.host_ticks();
         for (k, s) in program.segments.iter().enumerate() {
             let cmd = Command::LoadSegment {
                 index: k as u8,
@@ -481,7 +487,7 @@ impl<L: Link> Runner<'_, L> {
         // The overhead per request, as this upload measured it (a board may answer a
         // LOAD_SEGMENT slower than a READ_STATE).
         let n = program.segments.len();
-        let extra = (self.link.host_ticks() - t0 - self.upload_wire(n)) / (n + 2) as f64;
+        let extra = (self.host_ticks() - t0 - self.upload_wire(n)) / (n + 2) as f64;
         self.overhead = self.overhead.max(extra);
         match swap {
             Ok(()) => {
@@ -511,7 +517,7 @@ impl<L: Link> Runner<'_, L> {
     /// followed, once its swap has passed and been seen
     /// ([`Runner::seen_ticks`] later), by the upload of the rest (as [`Runner::extend`] leads
     /// it) armed before the board has played what it holds.
-    fn coverable(&self, timeline: &super::Timeline, at: u64, first: usize) -> bool {
+    fn coverable(&self, timeline: &crate::axis::Timeline, at: u64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let mut swap = at;
         let mut most = first.min(f.max_segments);
@@ -542,7 +548,7 @@ impl<L: Link> Runner<'_, L> {
     /// before the head ends, as [`Runner::defer_deadline`] has it) for as long as another such
     /// head takes to go up, so a command that comes meanwhile does not wait behind it. A head
     /// of the whole change always does.
-    fn roomy(&self, timeline: &super::Timeline, at: u64, first: usize) -> bool {
+    fn roomy(&self, timeline: &crate::axis::Timeline, at: u64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let rest = timeline.segments_from(at, &f);
         if rest.len() <= first {
@@ -668,7 +674,7 @@ impl<L: Link> Runner<'_, L> {
     /// The board's tick now, as the host knows it: the last READ_STATE's tick, and the ticks
     /// since (its reply's time on the wire, and the host's clock since it came).
     fn board_now(&self) -> u64 {
-        let since = self.reply_wire + (self.link.host_ticks() - self.polled).max(0.0);
+        let since = self.reply_wire + (self.host_ticks() - self.polled).max(0.0);
         self.last.ticks + since.ceil() as u64
     }
 
@@ -676,7 +682,7 @@ impl<L: Link> Runner<'_, L> {
     /// poll period, and two READ_STATE round trips (the one under way when the swap passes
     /// reads the tick before it).
     fn seen_ticks(&self) -> u64 {
-        let round_trip = self.bytes.read as f64 * self.link.byte_ticks() + self.overhead;
+        let round_trip = self.bytes.read as f64 * self.byte_ticks() + self.overhead;
         self.poll_ticks + (2.0 * round_trip).ceil() as u64
     }
 
@@ -689,7 +695,7 @@ impl<L: Link> Runner<'_, L> {
 
     /// Host ticks the frames of an upload of `n` segments take on the wire.
     fn upload_wire(&self, n: usize) -> f64 {
-        (n * self.bytes.load + self.bytes.arm) as f64 * self.link.byte_ticks()
+        (n * self.bytes.load + self.bytes.arm) as f64 * self.byte_ticks()
     }
 
     /// The lead a swap of an upload of `n` segments is armed with: its time
@@ -725,6 +731,7 @@ pub fn run<L: Link>(
     let ts = settings.format.ts;
     let mut r = Runner {
         link,
+        ts,
         axis: HostAxis::new(settings, first.ticks, regs(&first)),
         checks: 0,
         last: first,
@@ -834,13 +841,13 @@ pub fn run<L: Link>(
                 break;
             }
             let wait = (start + ticks_of(e.at_ms, ts)).saturating_sub(now);
-            r.link.wait(r.poll_ticks.min(wait).max(1));
+            r.wait_ticks(r.poll_ticks.min(wait).max(1));
             continue;
         }
         if r.settled(now) || now >= end_by {
             break;
         }
-        r.link.wait(r.poll_ticks);
+        r.wait_ticks(r.poll_ticks);
     }
     r.poll()?;
     Ok(RunReport {
@@ -854,61 +861,4 @@ pub fn run<L: Link>(
         swaps,
         start_tick: start,
     })
-}
-
-/// Writes the controlled stop's limits (raw) and powers the axis on (POWER 1; an axis already
-/// on is left so), as a run wants it.
-pub fn power_up<L: Link>(
-    link: &mut L,
-    stop: snapgen_model::stop::StopLimits,
-) -> Result<(), RunError> {
-    use crate::protocol::Param;
-    for c in [
-        Command::Configure {
-            param: Param::StopJerk,
-            value: stop.jerk,
-        },
-        Command::Configure {
-            param: Param::StopAccel,
-            value: stop.accel,
-        },
-        Command::Power { on: true },
-    ] {
-        match link.ask(&c)? {
-            Reply::Ack { .. }
-            | Reply::Nak {
-                reason: Reason::NotDisabled,
-                ..
-            } => {}
-            r => {
-                return Err(RunError::Board {
-                    what: "the set-up (CONFIGURE, POWER)",
-                    detail: format!("{r:?}"),
-                })
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Raw stop limits from a physical deceleration and jerk (unit/s², unit/s³) in `format`,
-/// each at least one LSB and at most what a CONFIGURE can set.
-pub fn stop_limits(
-    deceleration: f64,
-    jerk: f64,
-    format: &snapgen_model::format::Format,
-) -> snapgen_model::stop::StopLimits {
-    use crate::protocol::Param;
-    use snapgen_model::format::Quantity;
-    let raw = |v: f64, q: Quantity, p: Param| {
-        let r = snapgen_plan::planner::fmath::floor(v * format.scale(q));
-        if r >= p.max() as f64 {
-            p.max()
-        } else {
-            (r as i128).max(1)
-        }
-    };
-    let jerk = raw(jerk, Quantity::Jerk, Param::StopJerk);
-    let accel = raw(deceleration, Quantity::Acceleration, Param::StopAccel).max(jerk);
-    snapgen_model::stop::StopLimits { jerk, accel }
 }
