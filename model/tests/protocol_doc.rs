@@ -1,6 +1,6 @@
-//! docs/PROTOCOL.md against the contract (`snapgen_spec`): every table and the worked
-//! examples on the page are generated between markers, and the page must be what the
-//! generator writes (`SNAPGEN_BLESS=1 cargo test -p snapgen-model --test protocol_doc`
+//! docs/PROTOCOL.md (and BOARDS.md's pin table) against the contract (`snapgen_spec`): every
+//! table and the worked examples on the page are generated between markers, and the page must
+//! be what the generator writes (`SNAPGEN_BLESS=1 cargo test -p snapgen-model --test protocol_doc`
 //! rewrites it; `snapgen spec --update-docs` does the same). The examples' CRCs are checked with
 //! a second, table-driven CRC, and the numbers the prose states are the contract's.
 
@@ -36,33 +36,43 @@ fn table(doc: &str, header: &str) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// Each page with generated blocks is what the contract writes into it; the protocol page
+/// holds every block but the board's pins, which BOARDS.md holds.
 #[test]
-fn the_page_is_what_the_contract_generates() {
-    let page = doc();
-    let want = markdown::update(&page, &snapgen_model::spec_facts()).expect("the page's markers");
-    if std::env::var_os("SNAPGEN_BLESS").is_some() {
-        std::fs::write(path("PROTOCOL.md"), &want).unwrap();
-        return;
+fn the_pages_are_what_the_contract_generates() {
+    for name in markdown::PAGES {
+        let page = std::fs::read_to_string(path(name)).unwrap();
+        let want = markdown::update(&page, &snapgen_model::spec_facts())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        if std::env::var_os("SNAPGEN_BLESS").is_some() {
+            std::fs::write(path(name), &want).unwrap();
+            continue;
+        }
+        if page != want {
+            let line = page
+                .lines()
+                .zip(want.lines())
+                .position(|(a, b)| a != b)
+                .unwrap_or(page.lines().count().min(want.lines().count()));
+            panic!(
+                "docs/{name} differs from the contract from line {}: regenerate it with \
+                 `snapgen spec --update-docs` (or SNAPGEN_BLESS=1)\n page: {:?}\n want: {:?}",
+                line + 1,
+                page.lines().nth(line),
+                want.lines().nth(line)
+            );
+        }
     }
-    if page != want {
-        let line = page
-            .lines()
-            .zip(want.lines())
-            .position(|(a, b)| a != b)
-            .unwrap_or(page.lines().count().min(want.lines().count()));
-        panic!(
-            "docs/PROTOCOL.md differs from the contract from line {}: regenerate it with \
-             `snapgen spec --update-docs` (or SNAPGEN_BLESS=1)\n page: {:?}\n want: {:?}",
-            line + 1,
-            page.lines().nth(line),
-            want.lines().nth(line)
-        );
-    }
+    let protocol = doc();
+    let boards = std::fs::read_to_string(path("BOARDS.md")).unwrap();
     for b in markdown::BLOCKS {
-        assert!(
-            page.contains(&format!("<!-- spec:{b} -->")),
-            "the page has no {b} block"
-        );
+        let marker = format!("<!-- spec:{b} -->");
+        let page = if b == "board_pins" {
+            &boards
+        } else {
+            &protocol
+        };
+        assert!(page.contains(&marker), "no {b} block");
     }
 }
 

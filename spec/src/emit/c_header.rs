@@ -175,7 +175,7 @@ pub fn header() -> String {
          for (size_t i = 0; i < n; ++i) {\n        \
          crc ^= (uint16_t)((uint16_t)data[i] << 8);\n        \
          for (int k = 0; k < 8; ++k)\n            \
-         crc = (uint16_t)((crc & 0x8000u) ? ((crc << 1) ^ SNAPGEN_CRC_POLY) : (crc << 1));\n    \
+         crc = (uint16_t)((crc & 0x8000u) ? (((unsigned)crc << 1) ^ SNAPGEN_CRC_POLY) : ((unsigned)crc << 1));\n    \
          }\n    return crc;\n}\n\n#endif /* SNAPGEN_PROTOCOL_H */\n",
     );
     s

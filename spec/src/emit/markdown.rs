@@ -49,10 +49,25 @@ impl From<UnknownConstant> for DocError {
 }
 
 /// Every block a page may mark.
-pub const BLOCKS: [&str; 13] = [
-    "commands", "refusals", "states", "errors", "params", "replies", "reasons", "identity",
-    "status", "flags", "state", "config", "examples",
+pub const BLOCKS: [&str; 14] = [
+    "commands",
+    "refusals",
+    "states",
+    "errors",
+    "params",
+    "replies",
+    "reasons",
+    "identity",
+    "status",
+    "flags",
+    "state",
+    "config",
+    "examples",
+    "board_pins",
 ];
+
+/// The pages under docs/ with generated blocks.
+pub const PAGES: [&str; 2] = ["PROTOCOL.md", "BOARDS.md"];
 
 fn row(cells: &[String]) -> String {
     format!("| {} |\n", cells.join(" | "))
@@ -232,6 +247,28 @@ pub fn block(name: &str, extra: &[(&str, String)]) -> Result<String, DocError> {
             table(&["bit", "flag", "meaning"], rows)
         }
         "examples" => super::examples::markdown(),
+        "board_pins" => {
+            let rows = crate::ports::board_pins(1)
+                .into_iter()
+                .map(|p| {
+                    let wired = match p.wired {
+                        crate::ports::PinUse::Clock => "the clock".to_string(),
+                        crate::ports::PinUse::ResetButton => "the reset synchroniser".to_string(),
+                        crate::ports::PinUse::Io(name) => format!("`{name}`"),
+                    };
+                    Ok(vec![
+                        format!("`{}`", p.port),
+                        match p.dir {
+                            crate::ports::Dir::In => "in".to_string(),
+                            crate::ports::Dir::Out => "out".to_string(),
+                        },
+                        wired,
+                        x(p.doc)?,
+                    ])
+                })
+                .collect::<Result<Vec<_>, DocError>>()?;
+            table(&["port", "direction", "I/O top port", "what"], rows)
+        }
         other => return Err(DocError::UnknownBlock(other.to_string())),
     })
 }

@@ -1,28 +1,100 @@
-//! The CLI's side of `snapgen send` and `snapgen stop`: a session on a serial port with the
-//! one retry policy ([`snapgen_host::link`]), the controller's gains for the motor (from the
-//! plant, docs/PLANT.md), a progress bar, and the report. The move itself, its checks and the
-//! stop are the host's (`snapgen_host::send`).
+//! `snapgen send`: a move planned with the board's own Ts and format and run on it over a
+//! serial port: the controller's gains for the motor (from the plant, docs/PLANT.md), a
+//! progress bar, and the report. The move itself, its checks and the stop are the host's
+//! (`snapgen_host::send`).
 
 use std::io::IsTerminal;
+use std::path::PathBuf;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use snapgen_host::link::{FramedLink, RetryPolicy};
-use snapgen_host::send::{Progress, SendReport, ServoSetup};
-use snapgen_host::serial::{session_seq, SerialTransport};
-use snapgen_host::session::{Failure, InputError, Session};
+use snapgen_host::send::{check_ts, send_move, Progress, SendOptions, SendReport, ServoSetup};
+use snapgen_host::session::{InputError as HostInput, Session};
+use snapgen_model::DEFAULT_FORMAT;
 
-/// A session with the board on `port`.
-pub type SerialSession = Session<FramedLink<SerialTransport>>;
+use crate::args::{optional_motor, LinkArgs, PlanArgs, ServoArgs};
+use crate::error::{failure, InputError};
 
-/// Opens `port` at `baud` with `policy` and begins a session (PING, the board's format).
-pub fn open(
-    port: &str,
-    baud: u32,
-    policy: RetryPolicy,
-    position_lsb: f64,
-) -> Result<SerialSession, Failure> {
-    let t = SerialTransport::open(port, baud)?;
-    Session::open(FramedLink::new(t, policy, session_seq()), position_lsb)
+/// Plan a move and run it on a board over a serial port.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    link: LinkArgs,
+    /// Test hook: corrupt one bit of segment K's frame on every attempt.
+    #[arg(long, hide = true)]
+    corrupt_segment: Option<u8>,
+    /// Controlled stop (STOP) this many milliseconds after the start: the board brings the
+    /// axis to rest within the stop limits; the end is checked against the model's stop.
+    #[arg(long)]
+    stop_after_ms: Option<u64>,
+    /// The stop's deceleration limit, units/s² [default: the move's peak acceleration].
+    #[arg(long)]
+    stop_decel: Option<f64>,
+    /// The stop's jerk limit, units/s³ [default: the move's peak jerk].
+    #[arg(long)]
+    stop_jerk: Option<f64>,
+    /// Reset an axis found in ErrorStop (after its cause is removed) before the move.
+    #[arg(long)]
+    reset: bool,
+    /// The board's host watchdog, in milliseconds (written and read back): a moving axis
+    /// that hears nothing from the host for this long stops by itself. 0 turns it off.
+    #[arg(long, default_value_t = snapgen_spec::Param::WatchdogMs.spec().reset_value(0) as u32)]
+    watchdog_ms: u32,
+    /// The axis drives a motor: configure the board's controller for it (gains derived
+    /// from the plant, docs/PLANT.md) and report the following error and the settling.
+    /// `--motor` (or `--motor default`) for the default motor, `--motor FILE` for a plant
+    /// file.
+    #[arg(long, num_args = 0..=1, default_missing_value = "default")]
+    motor: Option<PathBuf>,
+    /// The settling band: the move has settled when |position − encoder| stays within this
+    /// many output LSBs (encoder counts).
+    #[arg(long, default_value_t = 2)]
+    settle_lsb: u32,
+    #[command(flatten)]
+    servo: ServoArgs,
+    #[command(flatten)]
+    plan: PlanArgs,
+}
+
+/// Runs the subcommand.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let request = a.plan.request().map_err(InputError::from)?;
+    let motor = optional_motor(a.motor.as_deref())?;
+    let lsb = a.plan.lsb.unwrap_or_else(|| {
+        motor.as_ref().map_or(DEFAULT_FORMAT.position_lsb, |m| {
+            m.physical().rad_per_count()
+        })
+    });
+    let mut session = a.link.open(lsb).map_err(failure)?;
+    session.link.corrupt_segment(a.corrupt_segment);
+    check_ts(&session, a.plan.ts).map_err(InputError::Host)?;
+    let servo = match motor {
+        Some(plant) => Some(
+            servo_setup(
+                &session,
+                &MotorOptions {
+                    plant,
+                    design: a.servo.design(),
+                    loop_hz: a.servo.loop_hz,
+                    pwm_hz: a.servo.pwm_hz,
+                },
+            )
+            .map_err(InputError::Host)?,
+        ),
+        None => None,
+    };
+    let opts = SendOptions {
+        ts: a.plan.ts,
+        stop_decel: a.stop_decel,
+        stop_jerk: a.stop_jerk,
+        reset: a.reset,
+        watchdog_ms: a.watchdog_ms,
+        servo,
+        settle_lsb: a.settle_lsb,
+        stop_after: a.stop_after_ms.map(|ms| ms as f64 / 1e3),
+    };
+    let r = send_move(&mut session, &request, &opts, &mut Bar::new()).map_err(failure)?;
+    print!("{}", describe(&r, &session.identity));
+    Ok(())
 }
 
 /// The motor the axis drives, and how to control it.
@@ -42,8 +114,8 @@ pub struct MotorOptions {
 pub fn servo_setup<L: snapgen_host::link::Link>(
     s: &Session<L>,
     m: &MotorOptions,
-) -> Result<ServoSetup, InputError> {
-    let bad = InputError::Servo;
+) -> Result<ServoSetup, HostInput> {
+    let bad = HostInput::Servo;
     let ts = s.format.ts;
     let ticks = (1.0 / (m.loop_hz * ts)).round();
     if !(m.loop_hz.is_finite() && m.loop_hz > 0.0 && (1.0..=65535.0).contains(&ticks)) {

@@ -5,10 +5,39 @@
 //! registers as the fabric holds them. Row `k` is the state after `k` ticks; `d` is the snap
 //! applied on the tick before it (0 on row 0).
 
+use std::fs::File;
 use std::io::{self, Write};
+use std::path::PathBuf;
 
+use anyhow::Context;
 use snapgen_model::{Quantity, Trace};
 use snapgen_plan::Plan;
+
+use crate::args::PlanArgs;
+
+/// Write the per-tick trace of a move as CSV.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    plan: PlanArgs,
+    /// Output CSV file.
+    #[arg(long)]
+    csv: PathBuf,
+    /// Write every N-th tick only (the last tick is always written).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+}
+
+/// Runs the subcommand.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let p = a.plan.plan()?;
+    let file =
+        File::create(&a.csv).with_context(|| format!("cannot create {}", a.csv.display()))?;
+    let rows = write_csv(&p, a.every, file)
+        .with_context(|| format!("cannot write {}", a.csv.display()))?;
+    eprintln!("wrote {rows} rows to {}", a.csv.display());
+    Ok(())
+}
 
 /// Writes the trace of `plan`, every `every`-th tick plus the last one.
 pub fn write_csv<W: Write>(plan: &Plan, every: u64, out: W) -> io::Result<u64> {

@@ -1,34 +1,95 @@
-//! `snapgen verilog` and `snapgen cosim`.
-
-use std::path::{Path, PathBuf};
+//! `snapgen cosim`: random moves on the Verilated motion core against the model, every
+//! output on every clock; its report, and with `--bench` the throughputs it is measured by.
 
 use std::io::IsTerminal;
+use std::path::PathBuf;
 
-use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
-use snapgen_model::device::Design;
-use snapgen_sim::cosim::{self, CosimConfig, CosimReport};
+use snapgen_sim::cosim::{self, CosimConfig, CosimReport, Fault};
+use snapgen_sim::moves::{
+    OrderMix, DEFAULT_REPLAN_SHARE, DEFAULT_STOP_SHARE, DEFAULT_STREAM_SHARE,
+};
 
-/// Files `snapgen verilog` writes.
-pub struct VerilogFiles {
-    /// The motion core (`snapgen_core.v`).
-    pub core: PathBuf,
-    /// The I/O top (`snapgen_io.v`: UART command interface, position controller, encoder, PWM, around `snapgen_core`).
-    pub io_top: PathBuf,
+use crate::error::{split_fault, InputError, Mismatched};
+
+/// Co-simulate random moves on the Verilated core against the model.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Moves to play.
+    #[arg(long, default_value_t = 100)]
+    moves: usize,
+    /// Seed of the random move stream.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Planners: 2, 3, 4 or mixed.
+    #[arg(long, default_value = "mixed")]
+    order: OrderMix,
+    /// Share of the moves given a controlled stop at a random clock (each stopping tick
+    /// takes the stop unit's decision, about 130 clocks).
+    #[arg(long, default_value_t = DEFAULT_STOP_SHARE)]
+    stop_share: f64,
+    /// Share of the other moves replanned on the way: 1 to 8 program swaps at random
+    /// ticks, each planned online from the state at its tick (docs/PROTOCOL.md, SWAP_AT).
+    #[arg(long, default_value_t = DEFAULT_REPLAN_SHARE)]
+    replan_share: f64,
+    /// Share of the moves played instead as PLCopen event streams: 3 to 12 random
+    /// MC_MoveAbsolute (every buffer mode), MC_MoveVelocity, MC_Halt and override changes
+    /// at random ticks, played by the host's own code through the board's command executor
+    /// beside the core (docs/ONLINE.md).
+    #[arg(long, default_value_t = DEFAULT_STREAM_SHARE)]
+    stream_share: f64,
+    /// Dump the whole run's waves to this VCD file.
+    #[arg(long)]
+    vcd: Option<PathBuf>,
+    /// Where to write the waves around a mismatch.
+    #[arg(long, default_value = "cosim-mismatch.vcd")]
+    mismatch_vcd: PathBuf,
+    /// Benchmark: repeat the run and the model alone 5 times each and print throughputs
+    /// (median, best) and the co-sim/model ratio.
+    #[arg(long, conflicts_with = "vcd")]
+    bench: bool,
+    /// Sessions: each its own Verilated core, model and sub-stream of moves; they run on
+    /// one thread per core. The moves played depend on it [default: 16].
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=256))]
+    sessions: Option<u16>,
+    /// Test hook: flip BIT of REGISTER at CLOCK in the captured fabric stream
+    /// ("CLOCK:REGISTER:BIT"), to show that a one-bit difference is reported.
+    #[arg(long, hide = true)]
+    inject_fault: Option<String>,
 }
 
-/// Writes the motion core's Verilog (`snapgen_core.v`) and the I/O top of `design`
-/// (`snapgen_io.v`, which instantiates `snapgen_core`). Each file carries its own lint
-/// waivers; the I/O top needs both.
-pub fn write_verilog(out: &Path, design: &Design) -> anyhow::Result<VerilogFiles> {
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let core = out.join(format!("{}.v", snapgen_hdl::verilog::CORE_PREFIX));
-    let io_top = out.join(format!("{}.v", snapgen_hdl::verilog::IO_PREFIX));
-    std::fs::write(&io_top, snapgen_hdl::verilog::io_top_verilog(design))
-        .with_context(|| format!("cannot write {}", io_top.display()))?;
-    std::fs::write(&core, snapgen_hdl::verilog::motion_core_verilog())
-        .with_context(|| format!("cannot write {}", core.display()))?;
-    Ok(VerilogFiles { core, io_top })
+/// Runs the subcommand: exit 1 on any mismatch, planner disagreement, swap fault or
+/// diverged stream.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let mut cfg = CosimConfig::new(a.moves, a.seed);
+    if let Some(n) = a.sessions {
+        cfg.session_count = usize::from(n);
+    }
+    cfg.mix = a.order;
+    cfg.stop_share = a.stop_share;
+    cfg.replan_share = a.replan_share;
+    cfg.stream_share = a.stream_share;
+    cfg.vcd = a.vcd;
+    cfg.mismatch_vcd = a.mismatch_vcd;
+    cfg.fault = a.inject_fault.map(|s| parse_fault(&s)).transpose()?;
+    let r = cosim(&cfg, a.bench)?;
+    if r.mismatch.is_some()
+        || r.planner_disagreements > 0
+        || r.swap_faults() > 0
+        || r.streams_diverged > 0
+    {
+        return Err(anyhow::Error::new(Mismatched));
+    }
+    Ok(())
+}
+
+fn parse_fault(s: &str) -> Result<Fault, InputError> {
+    let (clock, register, bit) = split_fault(s)?;
+    Ok(Fault {
+        clock,
+        register,
+        bit,
+    })
 }
 
 /// A bar of `moves` moves on stderr when it is a terminal (hidden otherwise).

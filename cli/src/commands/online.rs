@@ -41,6 +41,83 @@ use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
 
+use crate::error::{failure, InputError};
+use crate::scenario::Scenario;
+
+/// Play a timed script of PLCopen commands on a board.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The script (TOML, docs/ONLINE.md).
+    #[arg(
+        long,
+        conflicts_with = "scenario",
+        required_unless_present = "scenario"
+    )]
+    script: Option<PathBuf>,
+    /// A built-in scenario instead of a script.
+    #[arg(long, value_enum)]
+    scenario: Option<Scenario>,
+    /// The scenario's jerk (unit/s³) [seed002: 50000].
+    #[arg(long, requires = "scenario")]
+    jerk: Option<f64>,
+    /// The virtual board: the device model, or the Verilated I/O top with the device model
+    /// in lockstep (every output compared on every clock).
+    #[arg(long, value_enum, default_value = "model", conflicts_with = "port")]
+    board: BoardKind,
+    /// A real board's serial port instead of a virtual board.
+    #[arg(long)]
+    port: Option<String>,
+    /// Baud rate: the virtual board's UART (its design) or the port's.
+    #[arg(long, default_value_t = 115_200)]
+    baud: u32,
+    /// Write the per-tick integer trace (tick, x, v, a, j, position LSB).
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Plot position, velocity, acceleration and jerk with the events marked.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Print one JSON object (commands and outcomes, replans, ticks, final and target
+    /// position, final registers, mismatches) instead of the summary.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs the subcommand: exit 1 if the fabric and the model disagree.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (script, title) = match (a.script, a.scenario) {
+        (Some(path), _) => {
+            let title = format!("snapgen online {}", path.display());
+            (Script::read(&path).map_err(InputError::Script)?, title)
+        }
+        (None, Some(s)) => (
+            s.script(a.jerk).map_err(InputError::Script)?,
+            s.title(a.jerk),
+        ),
+        (None, None) => anyhow::bail!("give --script FILE or --scenario NAME"),
+    };
+    let target = Target {
+        board: a.board,
+        port: a.port,
+        baud: a.baud,
+    };
+    let played = play(script, &target)?;
+    if a.json {
+        println!("{}", json(&played));
+    } else {
+        println!("{title}\n{}", describe(&played));
+    }
+    if let Some(path) = a.csv {
+        write_csv(&played, &path)?;
+    }
+    if let Some(path) = a.svg {
+        write_svg(&played, &title, &path)?;
+    }
+    if played.mismatches.unwrap_or(0) > 0 {
+        return Err(anyhow::Error::new(crate::error::Mismatched));
+    }
+    Ok(())
+}
+
 /// A script file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -151,12 +228,12 @@ pub struct Played {
 /// Plays `script` on the board behind `link`: a session (PING, the board's format), the stop
 /// limits, the axis powered, the run. The stop-limit rule's warnings go to stderr.
 fn play_on<L: Link>(link: L, script: &Script) -> anyhow::Result<(RunReport, L)> {
-    let mut session = Session::open(link, DEFAULT_FORMAT.position_lsb).map_err(|e| match e {
-        snapgen_host::session::Failure::Input(i) => anyhow::Error::new(i),
-        snapgen_host::session::Failure::Host(h) => anyhow::Error::new(h),
-    })?;
+    let mut session = Session::open(link, DEFAULT_FORMAT.position_lsb).map_err(failure)?;
     let (report, _, warnings) = play_script(&mut session, &script.events, &script.options())
-        .map_err(|e: PlayError| anyhow::Error::new(e))?;
+        .map_err(|e| match e {
+            PlayError::Setup(f) => failure(f),
+            e => anyhow::Error::new(e),
+        })?;
     for w in warnings {
         eprintln!("warning: {w}");
     }
@@ -482,7 +559,7 @@ pub fn write_svg(p: &Played, title: &str, path: &Path) -> anyhow::Result<()> {
         .iter()
         .map(|e| offset + e.at_ms * 1e-3)
         .collect();
-    crate::plot::write_program_svg(&program, t.origin.1, &f, title, &events, path)
+    crate::svg::write_program_svg(&program, t.origin.1, &f, title, &events, path)
         .map_err(|e| anyhow::anyhow!("cannot draw {}: {e}", path.display()))
 }
 
@@ -495,7 +572,7 @@ mod tests {
     /// every kind of event.
     #[test]
     fn the_documented_script_is_valid() {
-        let doc = include_str!("../../docs/ONLINE.md");
+        let doc = include_str!("../../../docs/ONLINE.md");
         let start = doc.find("```toml\n").expect("a TOML block") + 8;
         let len = doc[start..].find("```").unwrap();
         let s: Script = toml::from_str(&doc[start..start + len]).unwrap();

@@ -22,6 +22,48 @@ use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
 use snapgen_model::device::Design;
 use snapgen_sim::board::VirtualBoard;
 
+use crate::args::{optional_motor, TimingArgs};
+
+/// A virtual board behind a pseudo-terminal.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Open a pseudo-terminal (the only transport so far).
+    #[arg(long, required = true)]
+    pty: bool,
+    /// Serve the device model instead of the Verilated fabric.
+    #[arg(long)]
+    model: bool,
+    /// The virtual board's clock in Hz (it must run in real time: a few MHz at most).
+    #[arg(long, default_value_t = VIRTUAL_CLOCK_HZ)]
+    clock_hz: f64,
+    /// UART baud rate (8N1).
+    #[arg(long, default_value_t = snapgen_model::timing::DEFAULT_BAUD)]
+    baud: u32,
+    /// Tick period Ts after reset, in seconds (a whole number of clocks).
+    #[arg(long, default_value_t = VIRTUAL_TS)]
+    ts: f64,
+    /// A simulated motor on the board's PWM and encoder instead of the ideal follower:
+    /// `--motor` (or `--motor default`) for the default one, `--motor FILE` for a plant
+    /// file (docs/PLANT.md).
+    #[arg(long, num_args = 0..=1, default_missing_value = "default")]
+    motor: Option<std::path::PathBuf>,
+}
+
+/// Runs the subcommand (until stopped).
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let timing = TimingArgs {
+        clock_hz: Some(a.clock_hz),
+        baud: a.baud,
+        ts: a.ts,
+    };
+    let (_, design) = timing.resolve(None, 0)?;
+    serve(BoardOptions {
+        design,
+        fabric: !a.model,
+        motor: optional_motor(a.motor.as_deref())?,
+    })
+}
+
 /// Output bytes kept while nobody reads the pseudo-terminal.
 const MAX_PENDING: usize = 64 * 1024;
 
@@ -50,7 +92,7 @@ fn path_of(fd: &OwnedFd) -> anyhow::Result<String> {
 }
 
 /// Runs the board until killed; prints the device path on the first line of stdout.
-pub fn run(opts: BoardOptions) -> anyhow::Result<()> {
+pub fn serve(opts: BoardOptions) -> anyhow::Result<()> {
     let pty = openpty(None, None).context("cannot open a pseudo-terminal")?;
     // Raw mode on both ends: bytes pass unchanged.
     for fd in [&pty.master, &pty.slave] {

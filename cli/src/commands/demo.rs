@@ -19,8 +19,21 @@ use snapgen_plan::{plan, plan_from, Method, MoveRequest, Plan};
 use snapgen_sim::cosim::CosimConfig;
 use snapgen_sim::moves::MoveSpec;
 
-use crate::plot;
 use crate::report::PlanReport;
+use crate::svg;
+
+/// The main job on built-in defaults.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory for the plots.
+    #[arg(long, default_value = "out/demo")]
+    out: std::path::PathBuf,
+}
+
+/// Runs the subcommand.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    demo(&a.out)
+}
 
 fn show(name: &str, p: &Plan, out: &Path) -> anyhow::Result<()> {
     println!("== {name}");
@@ -33,13 +46,13 @@ fn show(name: &str, p: &Plan, out: &Path) -> anyhow::Result<()> {
         "{name}: the program does not end exactly on target at rest"
     );
     let svg = out.join(format!("{name}.svg"));
-    plot::write_svg(p, name, &svg).map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
+    svg::write_svg(p, name, &svg).map_err(|e| anyhow::anyhow!("{}: {e}", svg.display()))?;
     println!("  plot: {}\n", svg.display());
     Ok(())
 }
 
 /// Runs the demo, writing plots into `out`.
-pub fn run(out: &Path) -> anyhow::Result<()> {
+pub fn demo(out: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let f: Format = DEFAULT_FORMAT;
     println!(
@@ -95,7 +108,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         &f,
         &snapgen_model::timing::Timing::default(),
     )?);
-    let files = crate::hw::write_verilog(&out.join("verilog"), &design)?;
+    let files = super::verilog::write_verilog(&out.join("verilog"), &design)?;
     println!(
         "  Verilog: {} and {}",
         files.core.display(),
@@ -202,16 +215,16 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     // top (the device model in lockstep, every output compared), at 125 MHz and 115 200 baud.
     println!("\n== online: seed 000 Figure 3 through the PLCopen host axis on the fabric (`snapgen online --scenario seed000-fig3 --board fabric`)");
     let sc = crate::scenario::Scenario::Seed000Fig3;
-    let played = crate::online::play(
+    let played = super::online::play(
         sc.script(None)?,
-        &crate::online::Target {
-            board: crate::online::BoardKind::Fabric,
+        &super::online::Target {
+            board: super::online::BoardKind::Fabric,
             port: None,
             baud: snapgen_model::timing::DEFAULT_BAUD,
         },
     )?;
-    println!("{}", crate::online::describe(&played));
-    crate::online::write_svg(
+    println!("{}", super::online::describe(&played));
+    super::online::write_svg(
         &played,
         &sc.title(None),
         &out.join("seed000_fig3_online.svg"),
@@ -242,10 +255,10 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     // Seed 001's experiment, short form, on the closed loop: the Verilated I/O top drives a
     // simulated maxon RE 40 with the paper's load; the device model compares every clock.
     println!("\n== closed loop: seed 001's experiment (short form: `snapgen experiment seed001` runs it whole)");
-    let o = crate::experiment::Options {
-        board: crate::experiment::Board::Fabric,
+    let o = super::experiment::Options {
+        board: super::experiment::Board::Fabric,
         plant: snapgen_plant::PlantParams::default_plant(),
-        clock_hz: crate::experiment::EXPERIMENT_CLOCK_HZ,
+        clock_hz: super::experiment::EXPERIMENT_CLOCK_HZ,
         ts: f.ts,
         pwm_hz: 20_000.0,
         loop_hz: 10_000.0,
@@ -255,8 +268,8 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         step_s: 1e-6,
         out: Some(out.join("seed001")),
     };
-    let r = crate::experiment::run(&o)?;
-    print!("{}", crate::experiment::table(&r));
+    let r = super::experiment::play(&o)?;
+    print!("{}", super::experiment::table(&r));
     ensure!(
         r.mismatches == Some(0),
         "the closed loop's fabric and model disagreed"

@@ -1,53 +1,28 @@
 //! Board descriptions: a board is data (device, clock, pins), read from TOML and checked
 //! before anything is generated from it. The schema is documented in docs/BOARDS.md; the
-//! built-in boards live in `gen/boards/`, and `--board-file FILE` reads a user's own.
+//! built-in boards live in `cli/boards/`, and `--board-file FILE` reads a user's own.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Deserialize;
+use snapgen_spec::ports::{board_pins, Dir};
 
-/// The ports of the board top (`snapgen build`), with their directions: every board file maps
-/// each of them to a package pin, and nothing else.
-pub const TOP_PORTS: [(&str, Direction, &str); 17] = [
-    ("btn_reset", Direction::In, "reset button, active high"),
-    (
-        "uart_rxd",
-        Direction::In,
-        "UART from the host into the fabric",
-    ),
-    (
-        "uart_txd",
-        Direction::Out,
-        "UART from the fabric to the host",
-    ),
-    ("enc_a", Direction::In, "encoder channel A"),
-    ("enc_b", Direction::In, "encoder channel B"),
-    ("enc_i", Direction::In, "encoder index"),
-    ("pwm", Direction::Out, "PWM to the amplifier"),
-    ("dir", Direction::Out, "direction to the amplifier"),
-    (
-        "amp_enable",
-        Direction::Out,
-        "amplifier enable (high: the amplifier may drive the motor)",
-    ),
-    (
-        "estop",
-        Direction::In,
-        "emergency stop input (polarity set by INPUT_POLARITY)",
-    ),
-    ("limit_pos", Direction::In, "positive limit switch input"),
-    ("limit_neg", Direction::In, "negative limit switch input"),
-    ("led[0]", Direction::Out, "LED: idle"),
-    ("led[1]", Direction::Out, "LED: busy"),
-    ("led[2]", Direction::Out, "LED: fault"),
-    ("led[3]", Direction::Out, "LED: heartbeat"),
-    (
-        "sysclk",
-        Direction::In,
-        "the clock (the [clock] table, not a [[pins]] entry)",
-    ),
-];
+/// The ports of the board top (`snapgen build`) with their directions and what they are for,
+/// from the spec's board pins (one axis): every board file maps each of them to a package pin
+/// (the clock in its `[clock]` table), and nothing else.
+pub fn top_ports() -> Vec<(String, Direction, &'static str)> {
+    board_pins(1)
+        .into_iter()
+        .map(|p| {
+            let dir = match p.dir {
+                Dir::In => Direction::In,
+                Dir::Out => Direction::Out,
+            };
+            (p.port, dir, p.doc)
+        })
+        .collect()
+}
 
 /// Yosys `synth_xilinx` families Vivado can also build (7 series and UltraScale).
 pub const FAMILIES: [&str; 3] = ["xc7", "xcu", "xcup"];
@@ -358,7 +333,9 @@ impl Board {
                 return Err(bad(&field, &p.port, "each port once"));
             }
         }
-        for (port, dir, what) in TOP_PORTS {
+        let top = top_ports();
+        for (port, dir, what) in &top {
+            let (port, dir) = (port.as_str(), *dir);
             match ports.get(port) {
                 None => {
                     return Err(bad(
@@ -387,11 +364,8 @@ impl Board {
                 Some(_) => {}
             }
         }
-        if let Some(extra) = ports
-            .keys()
-            .find(|p| !TOP_PORTS.iter().any(|(t, _, _)| t == *p))
-        {
-            let known: Vec<&str> = TOP_PORTS.iter().map(|(t, _, _)| *t).collect();
+        if let Some(extra) = ports.keys().find(|p| !top.iter().any(|(t, _, _)| t == *p)) {
+            let known: Vec<&str> = top.iter().map(|(t, _, _)| t.as_str()).collect();
             return Err(bad(
                 &format!("pins[{extra}]"),
                 extra,

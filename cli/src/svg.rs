@@ -1,4 +1,5 @@
-//! `snapgen plot`: position, velocity, acceleration, jerk and snap against time, as SVG.
+//! SVG plots (`snapgen plot`, `online --svg`, the experiment's figures): position, velocity,
+//! acceleration, jerk and snap against time.
 //!
 //! Long moves are drawn from per-bucket minima and maxima of the integer trace, so one-tick
 //! snap impulses stay visible however many ticks share a pixel.

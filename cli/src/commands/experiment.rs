@@ -27,6 +27,90 @@ use snapgen_plant::seed001::{profiles, PaperFigures, Profile, SETTLE_BAND};
 use snapgen_plant::{Physical, PlantParams};
 use snapgen_sim::closed_loop::{AxisSetup, ClosedLoop};
 
+use crate::args::{MotorArgs, ServoArgs};
+use crate::error::{InputError, Mismatched};
+
+/// Which experiment.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Which {
+    /// Seed 001, sections 3 and 4.
+    Seed001,
+}
+
+/// Seed 001's experiment on the closed loop.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Which experiment.
+    #[arg(value_enum)]
+    which: Which,
+    /// Where the loop runs: the Verilated I/O top with the device model in lockstep, the
+    /// device model, or the fast model-only loop.
+    #[arg(long, value_enum, default_value = "fabric")]
+    board: Board,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Directory for the SVG plots.
+    #[arg(long, default_value = "out/seed001")]
+    out: PathBuf,
+    /// Only the S-curve and the trapezoid, watched 0.5 s after their end.
+    #[arg(long)]
+    short: bool,
+    /// Leave out the 5 ms host-loop runs.
+    #[arg(long)]
+    no_host_loop: bool,
+    /// The fabric clock (Hz).
+    #[arg(long, default_value_t = EXPERIMENT_CLOCK_HZ)]
+    clock_hz: f64,
+    /// Tick period Ts (s).
+    #[arg(long, default_value_t = DEFAULT_FORMAT.ts)]
+    ts: f64,
+    /// The plant's integration step (µs).
+    #[arg(long, default_value_t = 1.0)]
+    step_us: f64,
+    #[command(flatten)]
+    motor: MotorArgs,
+    #[command(flatten)]
+    servo: ServoArgs,
+}
+
+/// Runs the subcommand: exit 1 if the fabric and the model disagree.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let Which::Seed001 = a.which;
+    let plant = a.motor.load()?;
+    let t = a.servo.timing(a.clock_hz, a.ts)?;
+    if !(a.step_us.is_finite() && a.step_us > 0.0) {
+        return Err(InputError::Board(format!(
+            "--step-us {}: give a positive step in µs",
+            a.step_us
+        ))
+        .into());
+    }
+    let o = Options {
+        board: a.board,
+        plant,
+        clock_hz: a.clock_hz,
+        ts: a.ts,
+        pwm_hz: a.clock_hz / f64::from(t.pwm_period),
+        loop_hz: 1.0 / (f64::from(t.servo_period) * a.ts),
+        design: a.servo.design(),
+        host_loop: !a.no_host_loop,
+        short: a.short,
+        step_s: a.step_us * 1e-6,
+        out: Some(a.out),
+    };
+    let r = play(&o)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        print!("{}", table(&r));
+    }
+    if r.mismatches.is_some_and(|m| m > 0) {
+        return Err(anyhow::Error::new(Mismatched));
+    }
+    Ok(())
+}
+
 /// Where the loop runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -168,7 +252,7 @@ fn format(p: &Physical, ts: f64) -> Format {
 }
 
 /// Runs it.
-pub fn run(o: &Options) -> anyhow::Result<Report> {
+pub fn play(o: &Options) -> anyhow::Result<Report> {
     let started = std::time::Instant::now();
     let p = o.plant.physical();
     let timing = Timing {
@@ -474,7 +558,7 @@ fn write_plots(r: &Report, dir: &Path, volts_per_duty: f64) -> anyhow::Result<()
             _ => "order4.svg",
         };
         let title = format!("seed 001, {name}: position error and control signal");
-        crate::plot::write_loop_svg(&title, &series, volts_per_duty, &dir.join(file))
+        crate::svg::write_loop_svg(&title, &series, volts_per_duty, &dir.join(file))
             .map_err(|e| anyhow::anyhow!("{file}: {e}"))?;
         eprintln!("wrote {}", dir.join(file).display());
     }
@@ -483,75 +567,3 @@ fn write_plots(r: &Report, dir: &Path, volts_per_duty: f64) -> anyhow::Result<()
 
 /// The default clock of the experiment's design (Hz).
 pub const EXPERIMENT_CLOCK_HZ: f64 = 10e6;
-
-/// `snapgen gains --json`.
-pub fn gains_json(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> serde_json::Value {
-    let p = plant.physical();
-    serde_json::json!({
-        "motor": plant.motor.name,
-        "plant": { "k_rad_per_s_per_v": g.plant_k, "tau_s": g.plant_tau, "counts_per_rev": p.counts_per_rev, "supply_v": p.vs },
-        "timing": { "ts": t.ts, "servo_period_ticks": t.servo_period, "sample_s": t.sample_s(), "pwm_period_clocks": t.pwm_period },
-        "bandwidth_hz": g.bandwidth_hz,
-        "volts": { "kp": g.volts.kp, "ki": g.volts.ki, "kd": g.volts.kd, "kv": g.volts.kv, "ka": g.volts.ka },
-        "duty": { "kp": g.physical.kp, "ki": g.physical.ki, "kd": g.physical.kd, "kv": g.physical.kv, "ka": g.physical.ka },
-        "configure": {
-            "SERVO_PERIOD": g.config.servo_period, "KP": g.config.kp, "KI": g.config.ki, "KD": g.config.kd,
-            "KV": g.config.kv, "KA": g.config.ka, "INTEGRAL_LIMIT": g.config.integral_limit,
-            "OUTPUT_LIMIT": g.config.output_limit, "FOLLOWING_LIMIT": g.config.following_limit,
-            "D_FILTER": g.config.d_filter, "PWM_PERIOD": t.pwm_period,
-        },
-    })
-}
-
-/// `snapgen gains`.
-pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
-    let p = plant.physical();
-    let c = &g.config;
-    format!(
-        "motor: {}\n\
-         plant: K = {:.4} rad/s per V, τ = {:.4} s (J {:.4e} kg·m², R {} Ω, Kt {} N·m/A), {} counts/rev, supply {} V\n\
-         loop: sample {} ticks of {} s ({:.0} Hz), PWM period {} clocks; bandwidth {:.2} Hz\n\
-         \n\
-         gain  volts and radians          PWM clocks, counts, samples, ticks   CONFIGURE\n\
-         KP    {:>12.5e} V/rad          {:>12.5e} per count                   {}\n\
-         KI    {:>12.5e} V/(rad·s)      {:>12.5e} per count·sample            {}\n\
-         KD    {:>12.5e} V·s/rad        {:>12.5e} per count/sample            {}\n\
-         KV    {:>12.5e} V·s/rad        {:>12.5e} per count/tick              {}\n\
-         KA    {:>12.5e} V·s²/rad       {:>12.5e} per count/tick²             {}\n\
-         INTEGRAL_LIMIT {}  OUTPUT_LIMIT {}  FOLLOWING_LIMIT {} counts  D_FILTER {}  SERVO_PERIOD {}  PWM_PERIOD {}\n",
-        plant.motor.name,
-        g.plant_k,
-        g.plant_tau,
-        p.j,
-        p.r,
-        p.kt,
-        p.counts_per_rev,
-        p.vs,
-        t.servo_period,
-        t.ts,
-        1.0 / t.sample_s(),
-        t.pwm_period,
-        g.bandwidth_hz,
-        g.volts.kp,
-        g.physical.kp,
-        c.kp,
-        g.volts.ki,
-        g.physical.ki,
-        c.ki,
-        g.volts.kd,
-        g.physical.kd,
-        c.kd,
-        g.volts.kv,
-        g.physical.kv,
-        c.kv,
-        g.volts.ka,
-        g.physical.ka,
-        c.ka,
-        c.integral_limit,
-        c.output_limit,
-        c.following_limit,
-        c.d_filter,
-        c.servo_period,
-        t.pwm_period,
-    )
-}

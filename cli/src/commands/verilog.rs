@@ -1,0 +1,60 @@
+//! `snapgen verilog`: the motion core (`snapgen_core.v`) and the I/O top (`snapgen_io.v`,
+//! which instantiates it) for a clock, baud rate and Ts.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use snapgen_model::device::Design;
+
+use crate::args::TimingArgs;
+
+/// Write the Verilog.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output directory.
+    #[arg(long, default_value = "out/verilog")]
+    out: PathBuf,
+    #[command(flatten)]
+    timing: TimingArgs,
+}
+
+/// Runs the subcommand.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (t, d) = a.timing.resolve(None, 0)?;
+    let files = write_verilog(&a.out, &d)?;
+    println!(
+        "wrote {} and {} (clock {} Hz, {} baud = {} clocks per bit ({} baud), Ts {} s = {} clocks, design hash {:#010x})",
+        files.core.display(),
+        files.io_top.display(),
+        t.clock_hz,
+        t.baud,
+        d.dividers.uart_divisor,
+        d.baud,
+        t.ts,
+        u64::from(d.dividers.tick_div) + 1,
+        d.design_hash
+    );
+    Ok(())
+}
+
+/// Files `snapgen verilog` writes.
+pub struct VerilogFiles {
+    /// The motion core (`snapgen_core.v`).
+    pub core: PathBuf,
+    /// The I/O top (`snapgen_io.v`: UART command interface, position controller, encoder, PWM, around `snapgen_core`).
+    pub io_top: PathBuf,
+}
+
+/// Writes the motion core's Verilog (`snapgen_core.v`) and the I/O top of `design`
+/// (`snapgen_io.v`, which instantiates `snapgen_core`). Each file carries its own lint
+/// waivers; the I/O top needs both.
+pub fn write_verilog(out: &Path, design: &Design) -> anyhow::Result<VerilogFiles> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let core = out.join(format!("{}.v", snapgen_hdl::verilog::CORE_PREFIX));
+    let io_top = out.join(format!("{}.v", snapgen_hdl::verilog::IO_PREFIX));
+    std::fs::write(&io_top, snapgen_hdl::verilog::io_top_verilog(design))
+        .with_context(|| format!("cannot write {}", io_top.display()))?;
+    std::fs::write(&core, snapgen_hdl::verilog::motion_core_verilog())
+        .with_context(|| format!("cannot write {}", core.display()))?;
+    Ok(VerilogFiles { core, io_top })
+}
