@@ -10,8 +10,9 @@
 //! program being read (the standby bank's, at address 0) in place of the tick's usual step,
 //! busy or not, so the next tick is the new program's first.
 //!
-//! When a controlled stop is taken (`engage`, on a tick) the program is cut there: busy and
-//! done fall and the snap drops to 0 (the stop unit feeds the chain from the next tick). The
+//! When a controlled stop is taken (`engage`, on a tick) a program playing is cut there: busy
+//! falls (`done` is left as it is: false while a program plays, true if it ended before the
+//! stop was taken) and the snap drops to 0 (the stop unit feeds the chain from the next tick). The
 //! tick counter counts every tick while a program plays or a stop runs (`stopping`).
 
 use rust_hdl::prelude::*;
@@ -173,8 +174,9 @@ impl Logic for Sequencer {
                     self.snap_reg.d.next = self.entry_snap.val();
                 }
             } else if self.engage.val() {
+                // `done` is left: false while a program plays, and a program that ended before
+                // the stop was taken did run to its end.
                 self.busy_reg.d.next = false;
-                self.done_reg.d.next = false;
                 self.snap_reg.d.next = self.snap_zero.val();
             } else if self.busy_reg.q.val() {
                 if self.left.q.val() == self.ticks_one.val() {

@@ -108,6 +108,9 @@ wire swap_far = !swap_lead_q[TIME_BITS-1]
    && (swap_lead_q[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
 wire [SWAP_BITS-1:0] swap_before = swap_tick[SWAP_BITS-1:0] - 1'b1;   // the core's swap_last: T − 1
 wire toward_limit = (first_pos_q && limit_pos) || (first_neg_q && limit_neg);
+// ErrorStop with the amplifier off and the axis at rest: nothing can move, as while Disabled,
+// so the parameters settable only while Disabled may be set (INPUT_POLARITY set back).
+wire inert = (state_q == S_ERROR_STOP) && !amplifier_q && !moving;
 reg [7:0] reason;
 always @(*) begin
    reason = 8'd0;
@@ -147,7 +150,7 @@ always @(*) begin
    CMD_CONFIGURE:
       if (!param_known(cfg_param) || cfg_value[D_BITS-1] || cfg_over) reason = R_BAD_ARGUMENT;
       else if (param_at_rest(cfg_param) && moving) reason = R_BUSY;
-      else if (param_disabled(cfg_param) && (state_q != S_DISABLED)) reason = R_NOT_DISABLED;
+      else if (param_disabled(cfg_param) && (state_q != S_DISABLED) && !inert) reason = R_NOT_DISABLED;
       else if ((state_q != S_DISABLED) && ((cfg_param == P_STOP_JERK) || (cfg_param == P_STOP_ACCEL))
             && !cfg_pair_valid) reason = R_BAD_ARGUMENT;
    CMD_READ_CONFIG:

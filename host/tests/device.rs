@@ -617,3 +617,97 @@ fn a_replan_swaps_in_at_its_tick_over_the_wire() {
     assert_eq!(f.output_lsb(end.x), cell);
     assert_eq!(b.status().flags & flag::SWAP_PENDING, 0);
 }
+
+/// STOP and HALT sent at rest after a program ran to its end leave DONE set (the last program
+/// did run to its end, docs/PROTOCOL.md) and CUT clear: a STOP once cleared DONE, so the host
+/// could not tell the move had completed.
+#[test]
+fn a_stop_or_halt_at_rest_after_a_program_keeps_done() {
+    let f = DEFAULT_FORMAT;
+    let mut b = Bench::new();
+    b.run(10);
+    let p = plan_from(
+        &MoveRequest {
+            distance: 0.001,
+            method: Method::Order3 {
+                vmax: 1.0,
+                amax: 50.0,
+                jmax: 5e3,
+            },
+        },
+        &f,
+        ChainState::at_rest(f.home_raw()),
+    )
+    .unwrap();
+    powered_with(&mut b, &p.program.segments);
+    assert_eq!(b.ask(Command::Start), ack(&Command::Start));
+    let at_rest = |b: &mut Bench| {
+        let s = b.status();
+        (s.state == AxisState::Standstill as u8 && !s.has(flag::PLAYING | flag::STOPPING))
+            .then_some(s)
+    };
+    let s = loop {
+        if let Some(s) = at_rest(&mut b) {
+            break s;
+        }
+    };
+    assert!(s.has(flag::DONE) && !s.has(flag::CUT), "{s:?}");
+    for c in [Command::Stop, Command::Halt] {
+        assert_eq!(b.ask(c), ack(&c));
+        let s = loop {
+            if let Some(s) = at_rest(&mut b) {
+                break s;
+            }
+        };
+        assert!(s.has(flag::DONE), "{c:?} at rest cleared DONE: {s:?}");
+        assert!(!s.has(flag::CUT), "{c:?} at rest set CUT: {s:?}");
+    }
+}
+
+/// INPUT_POLARITY set (while Disabled) so that the emergency stop reads active latches
+/// ErrorStop with the amplifier off; it can be set back there (the amplifier is off and
+/// nothing moves, as while Disabled), then RESET gives Disabled. It once needed a power
+/// cycle: every Disabled-only parameter was refused in ErrorStop. With the amplifier on, or
+/// with the axis moving, the parameter stays refused.
+#[test]
+fn an_emergency_stop_made_active_by_input_polarity_can_be_undone() {
+    let mut b = Bench::new();
+    b.run(10);
+    let polarity = |value| Command::Configure {
+        param: Param::InputPolarity,
+        value,
+    };
+    // Bit 2 inverts the emergency stop: the idle input now reads active.
+    assert_eq!(b.ask(polarity(4)), ack(&polarity(4)));
+    b.run(50);
+    let s = b.status();
+    assert_eq!(
+        (s.state, s.error),
+        (AxisState::ErrorStop as u8, ErrorId::EmergencyStop as u8)
+    );
+    assert_eq!(b.ask(Command::Reset), nak(code::RESET, Reason::AxisError));
+    assert_eq!(b.ask(polarity(0)), ack(&polarity(0)));
+    b.run(50);
+    assert_eq!(b.ask(Command::Reset), ack(&Command::Reset));
+    let s = b.status();
+    assert_eq!(s.state, AxisState::Disabled as u8);
+    assert!(!s.has(flag::EMERGENCY_STOP));
+    // Enabled, the parameter stays Disabled-only.
+    for c in [
+        Command::Configure {
+            param: Param::StopJerk,
+            value: 10,
+        },
+        Command::Configure {
+            param: Param::StopAccel,
+            value: 1000,
+        },
+        Command::Power { on: true },
+    ] {
+        assert_eq!(b.ask(c), ack(&c));
+    }
+    assert_eq!(
+        b.ask(polarity(0)),
+        nak(code::CONFIGURE, Reason::NotDisabled)
+    );
+}

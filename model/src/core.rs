@@ -17,8 +17,8 @@
 //!   stopping with the stop unit's.
 //! * `stop` (a controlled stop, [`crate::stop`]) latches the stop limits and starts the stop
 //!   unit's *Prep* phase (`prep` clocks of [`phase_clocks`], the move plays on); the first tick
-//!   after it takes the stop: the program is cut there (busy and done fall, `aborted` rises if
-//!   it was playing), then the unit spends `init` clocks computing where its law begins and
+//!   after it takes the stop: a program playing is cut there (busy falls, `aborted` rises;
+//!   `done` is left: a program that ended first did run to its end), then the unit spends `init` clocks computing where its law begins and
 //!   `decide` clocks before every tick choosing that tick's snap (ticks wait for it); when the
 //!   registers are at rest it lets go (`stopping` falls). Requests while a stop runs are
 //!   ignored.
@@ -251,9 +251,10 @@ impl CoreModel {
                     self.snap = entry_snap;
                 }
             } else if engage {
-                // The stop takes the program's place from the next tick.
+                // The stop takes the program's place from the next tick. DONE is left as it
+                // is: false while a program plays (the program is cut), and a program that
+                // ended before the stop was taken did run to its end.
                 self.busy = false;
-                self.done = false;
                 self.snap = 0;
             } else if self.busy {
                 if self.left == 1 {
@@ -497,6 +498,60 @@ mod tests {
             ..Default::default()
         });
         assert!(!m.busy() && m.outputs().done);
+    }
+
+    /// A program swapped in by SWAP_AT that plays to its end while a STOP is being prepared
+    /// (the STOP came 7 ticks after the swap tick; the preparation lasts longer than the
+    /// program) ends DONE, not cut: the stop, taken from rest, cuts nothing. Before the fix
+    /// the stop's taking cleared DONE, and the host saw neither DONE nor CUT.
+    #[test]
+    fn a_swapped_program_that_ends_while_a_stop_is_prepared_is_done() {
+        let c = phase_clocks();
+        let mut m = reset();
+        let long = Program {
+            segments: vec![Segment {
+                ticks: 5_000,
+                snap: 0,
+            }],
+        };
+        load(&mut m, &long);
+        m.clock(&CoreInputs {
+            start: true,
+            ..Default::default()
+        });
+        let short = Program {
+            segments: vec![Segment { ticks: 20, snap: 0 }],
+        };
+        assert!(u64::from(short.segments[0].ticks) + 7 < u64::from(c.prep));
+        load(&mut m, &short);
+        let at = m.outputs().ticks + 10;
+        m.clock(&CoreInputs {
+            swap: true,
+            swap_last: (at - 1) as u32,
+            ..Default::default()
+        });
+        while m.outputs().ticks < at + 7 {
+            m.clock(&CoreInputs::default());
+        }
+        assert!(
+            m.busy() && m.outputs().tick_count < 10,
+            "the short program plays"
+        );
+        m.clock(&CoreInputs {
+            stop: true,
+            stop_jerk: 5,
+            stop_accel: 1000,
+            ..Default::default()
+        });
+        let mut clocks = 0;
+        while m.busy() || m.stopping() {
+            m.clock(&CoreInputs::default());
+            clocks += 1;
+            assert!(clocks < 100_000);
+        }
+        let o = m.outputs();
+        assert!(o.done, "the program ran to its end: DONE");
+        assert!(!o.aborted, "nothing was cut");
     }
 
     /// A controlled stop in the middle of a move: prepared while the move plays on, taken on

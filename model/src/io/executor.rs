@@ -412,6 +412,10 @@ impl Executor {
     fn check(&self, i: &ExecutorInputs, s: AxisState, cfg: Config) -> Result<(), Reason> {
         let rx = &i.rx;
         let moving = i.core.busy || i.core.stopping || !i.core.at_rest;
+        // In ErrorStop with the amplifier off and the axis at rest nothing can move, as while
+        // Disabled: the parameters settable only while Disabled may be set (INPUT_POLARITY
+        // made the emergency stop read active: it can be set back, then RESET).
+        let inert = s == AxisState::ErrorStop && !self.out.amplifier && !moving;
         let toward_limit =
             (self.first_direction > 0 && i.limit_pos) || (self.first_direction < 0 && i.limit_neg);
         let refuse = match rx.cmd {
@@ -464,7 +468,9 @@ impl Executor {
                     Some(p) if value < 0 || value > p.max() => Some(Reason::BadArgument),
                     Some(p) => match p.settable() {
                         Settable::AtRest if moving => Some(Reason::Busy),
-                        Settable::Disabled if s != AxisState::Disabled => Some(Reason::NotDisabled),
+                        Settable::Disabled if !(s == AxisState::Disabled || inert) => {
+                            Some(Reason::NotDisabled)
+                        }
                         _ if s != AxisState::Disabled && !stop_pair_valid(cfg, p, value) => {
                             Some(Reason::BadArgument)
                         }
