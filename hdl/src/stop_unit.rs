@@ -245,7 +245,10 @@ const DERIVED_LOGIC: [(&str, &str); 16] = [
     ("d_excess_hold", "d_level_hold"),
     ("d_excess_grid", "d_level_grid"),
     ("d_excess_limit", "d_level_limit"),
-    ("d_next_brake", "d_below | (d_brake & flags[F_BGT])"),
+    (
+        "d_next_brake",
+        "d_below | (d_brake & flags[F_BGT]) | (flags[F_OVER] & flags[F_ZERO])",
+    ),
     (
         "d_next_hold",
         "(d_brake & ~flags[F_BGT]) | (d_release & ~(flags[F_BRAKE] & flags[F_ABOVE]) & d_at_limit & flags[F_EHOK])",

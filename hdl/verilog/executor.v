@@ -422,6 +422,12 @@ always @(*) begin
       n_state = S_ERROR_STOP;
       n_error = E_EMERGENCY_STOP;
    end
+   // A stop or an abort cancels an armed swap, and its program, planned for the swap's tick,
+   // never plays from another state: the standby bank is emptied.
+   if ((n_stop || n_abort) && swap_pending) begin
+      n_count_enable = 1'b1;
+      n_count_value = {INDEX_BITS{1'b0}};
+   end
 
 end
 

@@ -12,7 +12,8 @@
 //!   lowered to it (never the deceleration raised to the jerk: that would stop harder than
 //!   the machine was rated for).
 //! * A limit given below the axis's own peak is allowed, with a warning: a stop from that
-//!   peak begins outside its limits (it still lands exactly, flagged STOP_OVER_LIMITS).
+//!   peak begins outside its limits (flagged STOP_OVER_LIMITS), and is bounded by the move's
+//!   own acceleration (docs/MODEL.md §9).
 
 use snapgen_model::format::{Format, Quantity};
 use snapgen_model::stop::StopLimits;
@@ -98,7 +99,7 @@ fn raw(
     let r = r as i128;
     if r < s.peak {
         warnings.push(format!(
-            "{} {x} is below the axis's peak ({:.6e}): a stop from there begins outside its limits (it still lands exactly, flagged STOP_OVER_LIMITS)",
+            "{} {x} is below the axis's peak ({:.6e}): a stop from there begins outside its limits (flagged STOP_OVER_LIMITS; it is bounded by the move's own acceleration, docs/PROTOCOL.md \"Stopping\")",
             s.flag,
             s.peak as f64 / f.scale(q)
         ));

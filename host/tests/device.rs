@@ -711,3 +711,29 @@ fn an_emergency_stop_made_active_by_input_polarity_can_be_undone() {
         nak(code::CONFIGURE, Reason::NotDisabled)
     );
 }
+
+/// A STOP that cancels an armed swap also empties the standby bank: the program uploaded for
+/// the swap's tick was planned from the state at that tick and must never play from another
+/// (a START after the stop once played it from rest). NAK NO_PROGRAM after the stop.
+#[test]
+fn a_stop_that_cancels_a_swap_empties_the_standby_program() {
+    use snapgen_model::program::Segment;
+    let mut b = Bench::new();
+    b.run(10);
+    powered_with(&mut b, &[Segment { ticks: 10, snap: 0 }]);
+    let st = state(&mut b);
+    let c = Command::SwapAt {
+        tick: st.ticks + 100_000,
+    };
+    assert_eq!(b.ask(c), ack(&c));
+    assert!(b.status().has(flag::SWAP_PENDING));
+    assert_eq!(b.ask(Command::Stop), ack(&Command::Stop));
+    loop {
+        let s = b.status();
+        if s.state == AxisState::Standstill as u8 && !s.has(flag::STOPPING) {
+            assert!(!s.has(flag::SWAP_PENDING));
+            break;
+        }
+    }
+    assert_eq!(b.ask(Command::Start), nak(code::START, Reason::NoProgram));
+}

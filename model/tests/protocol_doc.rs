@@ -129,11 +129,30 @@ fn every_worked_example_has_its_length_and_a_good_crc() {
 fn the_stop_timing_on_the_page_is_the_stop_units() {
     let d = doc();
     let c = snapgen_model::stop::phase_clocks();
-    let prep = (f64::from(c.prep) / 10.0).round() as u32 * 10;
+    let tens = |n: u32| (f64::from(n) / 10.0).round() as u32 * 10;
     assert!(
-        d.contains(&format!("about {prep} clocks while the move plays on")),
+        d.contains(&format!(
+            "about {} clocks from the request, while the move plays on",
+            tens(c.prep)
+        )),
         "prep {}",
         c.prep
+    );
+    assert!(
+        d.contains(&format!(
+            "about {} clocks compute where the law begins",
+            tens(c.init)
+        )),
+        "init {}",
+        c.init
+    );
+    assert!(
+        d.contains(&format!(
+            "at most about {} clocks after the tick that took the stop",
+            tens(c.init + c.decide)
+        )),
+        "init + decide {}",
+        c.init + c.decide
     );
     assert!(
         d.contains(&format!("(a tick divider below {})", c.decide)),

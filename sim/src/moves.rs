@@ -114,7 +114,7 @@ pub fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
 impl MoveStream {
     /// The stream for `seed`: a share `stream_share` of the moves are PLCopen event streams
     /// (3 to 12 events); of the others, a share `stop_share` get a controlled stop (each
-    /// stopping tick takes the stop unit's decision, about 130 clocks) and a share
+    /// stopping tick takes the stop unit's decision, about 140 clocks) and a share
     /// `replan_share` of the rest 1 to 8 online replans.
     pub fn new(
         seed: u64,

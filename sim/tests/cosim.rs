@@ -274,3 +274,57 @@ fn unchanged_verilog_is_not_rebuilt() {
     build(&v, false).unwrap();
     assert!(build(&v, false).unwrap().cached);
 }
+
+/// The stop's release rule on the fabric: moves stopped in their deceleration with a stop jerk
+/// of one LSB, where a release at STOP_JERK would reverse (the law's `E < 0`) but the next
+/// velocity and acceleration do not (`V + Λ > 0`) — checked on the model's chain for every
+/// tick the stop may be taken on — so the stop steps the acceleration to zero at once, then
+/// brakes within its limits. Fabric and model agree on every clock, and each stop is reported
+/// outside its limits and ends at rest.
+#[test]
+fn a_stop_that_releases_at_once_matches_on_the_fabric() {
+    use snapgen_model::stop::{phase_clocks, StopLaw, StopLimits};
+    use snapgen_model::{ChainState, Format};
+    use snapgen_plan::{plan, Method, MoveRequest};
+    use snapgen_sim::moves::MoveSpec;
+    let f = Format::with_ts(1e-5);
+    let prep = u64::from(phase_clocks().prep);
+    let mut moves = Vec::new();
+    for (k, distance) in [0.3, -0.5, 0.8].into_iter().enumerate() {
+        let request = MoveRequest {
+            distance,
+            method: Method::Order3 {
+                vmax: 1.0,
+                amax: 50.0,
+                jmax: 5e3,
+            },
+        };
+        let p = plan(&request, &f).unwrap();
+        let limits = StopLimits {
+            jerk: 1,
+            accel: 1 << 90,
+        };
+        // Requested so that it is taken 600–700 ticks before the end: in the deceleration at
+        // its full value (the last jerk ramp takes 100 ticks).
+        let total = p.ticks_total();
+        let request_at = total - 650 - prep;
+        for t in request_at + prep - 50..request_at + prep + 50 {
+            let s = ChainState::at_rest(f.home_raw()).after_ticks(&p.program, t, &f.widths);
+            let law = StopLaw::begin(s.v, s.a, s.j, limits);
+            let (vv, lambda) = (s.v + s.a, s.a + s.j);
+            assert!(
+                law.over_limits() && (vv + lambda) * vv.signum() > 0,
+                "move {k}, tick {t}: not a release state"
+            );
+            assert!(lambda.abs() > 1 << 40, "move {k}: decelerating");
+        }
+        moves.push(MoveSpec {
+            stop_after: Some(request_at),
+            stop_limits: limits,
+            ..MoveSpec::plain(request, f.ts)
+        });
+    }
+    let r = run(&verilog(), &CosimConfig::fixed(moves)).unwrap();
+    assert_eq!(r.mismatch, None);
+    assert_eq!((r.stopped, r.stops_over, r.stops_not_at_rest), (3, 3, 0));
+}

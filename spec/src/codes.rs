@@ -226,7 +226,7 @@ named_codes! {
         EmergencyStop = 1, "EMERGENCY_STOP", "the emergency-stop input";
         LimitPositive = 2, "LIMIT_POSITIVE", "motion toward the active positive limit switch";
         LimitNegative = 3, "LIMIT_NEGATIVE", "motion toward the active negative limit switch";
-        Watchdog = 4, "WATCHDOG", "no good frame for WATCHDOG_MS while moving";
+        Watchdog = 4, "WATCHDOG", "no good frame for WATCHDOG_MS in DiscreteMotion or ContinuousMotion (moving, or at rest with a swap armed)";
         ProgramEnd = 5, "PROGRAM_END", "a program ended with the axis not at rest (v, a or j ≠ 0): controlled stop";
         FollowingError = 6, "FOLLOWING_ERROR", "the following error passed FOLLOWING_LIMIT: amplifier off at once, the reference holds";
     }

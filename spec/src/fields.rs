@@ -172,7 +172,7 @@ macro_rules! with_status_fields {
         state: u8 = 1, unsigned, "axis state (above)";
         error: u8 = 1, unsigned, "error identifier (above)";
         flags: u16 = 2, unsigned, "flag bits (below)";
-        tick_count: u32 = 4, unsigned, "ticks since the last START, counted while a program plays or a stop runs; START and reset clear it";
+        tick_count: u32 = 4, unsigned, "ticks since the last START or program swap, counted while a program plays or a stop runs; START, a swap and reset clear it";
         position: i32 = 4, signed, "the reference position in output LSBs: the position register shifted right by {FRAC_BITS} (rounded toward −∞), low 32 bits, signed";
         velocity: i32 = 4, signed, "the velocity register's top 32 bits (signed): physical velocity ≈ velocity · 2^{VELOCITY_SHIFT} · L / Ts";
         encoder: i32 = 4, signed, "the quadrature count (×4 decoding), signed: where the motor is, against `position`, where it should be";

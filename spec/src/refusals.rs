@@ -66,7 +66,7 @@ pub const REFUSALS: [Refusal; 24] = {
         refusal(
             "CONFIGURE",
             &[NotDisabled],
-            "a parameter set only while Disabled, in another state",
+            "a parameter set only while Disabled, in another state (but ErrorStop with the amplifier off and the axis at rest)",
         ),
         refusal(
             "CONFIGURE",

@@ -4,9 +4,13 @@
 //!   to rest within those limits, so it is stoppable — known without asking the stop law): the
 //!   stop ends exactly at rest (v = a = j = 0), never exceeds the limits on any tick and never
 //!   reverses direction, and the law agrees that the state was within its limits;
-//! * from arbitrary states: it always ends exactly at rest, in bounded time; whenever the law
-//!   says the state was within its limits, the trace confirms it (no tick over a limit, no
-//!   reversal).
+//! * from arbitrary states: it always ends exactly at rest, in bounded time, within the bound
+//!   it keeps from any state (docs/MODEL.md §9: `|a| ≤ max(A, |Λ₀|)`, `|j| ≤ J` but on the
+//!   release tick, no reversal the registers had not decided); whenever the law says the state
+//!   was within its limits, the trace confirms it (no tick over a limit, no reversal);
+//! * from any tick of an online plan that reverses, within the stop's limits (a stop there
+//!   may need a jerk above `J` not to reverse): the acceleration never leaves `A` and the jerk
+//!   stays within `2A`. The law once landed such states in two ticks at up to 755·A.
 //!
 //! The chain is stepped here (`x += v; v += a; a += j; j += d`), independently of the model's.
 //! `PROPTEST_CASES` raises the case count.
@@ -64,6 +68,38 @@ fn assert_promises(trace: &[ChainState], start: ChainState, limits: StopLimits) 
                 "accel over the limit at tick {k}: {s:?}"
             );
         }
+    }
+}
+
+/// The bound a stop keeps from any state (docs/MODEL.md §9): exactly at rest at the end;
+/// `|a| ≤ max(A, |Λ₀|)` on every tick; `|j| ≤ J` on every tick but the release's (`|Λ₀|`) and
+/// the landing of a reversal the registers had already decided (below `2|Λ₀|`); no reversal
+/// but that one.
+fn assert_bound(trace: &[ChainState], start: ChainState, limits: StopLimits) {
+    let end = trace.last().copied().unwrap_or(start);
+    assert!(end.is_at_rest(), "not at rest: {end:?}");
+    let (vv, lambda) = (start.v + start.a, start.a + start.j);
+    let dir = if vv != 0 {
+        vv.signum()
+    } else {
+        lambda.signum().max(1)
+    };
+    let decided = (vv + lambda) * dir < 0;
+    let amax = limits.accel.max(lambda.abs());
+    let jmax = limits.jerk.max(lambda.abs() * if decided { 2 } else { 1 });
+    for (k, s) in trace.iter().enumerate() {
+        assert!(
+            s.a.abs() <= amax,
+            "|a| over max(A, |Λ₀|) at tick {k}: {s:?} from {start:?}"
+        );
+        assert!(
+            s.j.abs() <= jmax,
+            "|j| over the bound at tick {k}: {s:?} from {start:?}"
+        );
+        assert!(
+            decided || s.v * dir >= 0,
+            "reversed at tick {k}: {s:?} from {start:?}"
+        );
     }
 }
 
@@ -132,6 +168,7 @@ proptest! {
         let (a, j) = (s.a, s.j);
         let end = trace.last().copied().unwrap_or(s);
         prop_assert!(end.is_at_rest(), "not at rest after {} ticks: {:?}", trace.len(), end);
+        assert_bound(&trace, s, limits);
         let within = a.abs() <= limits.accel && j.abs() <= limits.jerk;
         if within && !law.over_limits() {
             assert_promises(&trace, s, limits);
@@ -203,4 +240,89 @@ fn an_unstoppable_state_is_reported_and_still_lands() {
     let (trace, law) = stop_from(s, limits, 1000);
     assert!(law.over_limits());
     assert!(trace.last().unwrap().is_at_rest());
+}
+
+/// From any tick of an online plan that reverses (a move, then a target behind it planned
+/// from a tick of it), with stop limits at exactly the two programs' own peaks: some states
+/// brake toward the reversal harder than a release at J can undo (the law reports them), and
+/// from every state the stop keeps `|a| ≤ A` and `|j| ≤ 2A` (`≤ A` but when landing a reversal
+/// the registers had already decided), never reversing but there. Before the release rule the end game landed such states
+/// in two ticks at up to 755·A.
+#[test]
+fn a_stop_from_a_reversing_plan_within_the_limits_keeps_the_bound() {
+    use rand::{Rng, SeedableRng};
+    use snapgen_model::peaks::peaks;
+    use snapgen_plan::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
+    let f = Format::with_ts(1e-4);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2026);
+    let mut lu = |lo: f64, hi: f64| rng.gen_range(lo.ln()..hi.ln()).exp();
+    let (mut stops, mut over) = (0, 0);
+    let mut cases = Vec::new();
+    for _ in 0..3000 {
+        cases.push((
+            OnlineLimits {
+                velocity: lu(0.05, 2.0),
+                acceleration: lu(1.0, 50.0),
+                deceleration: lu(1.0, 50.0),
+                jerk: lu(10.0, 5e3),
+            },
+            lu(100.0, 1e6),
+            lu(1.0, 1e6),
+        ));
+    }
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    for (l, ahead, behind) in cases {
+        let start = ChainState::at_rest(f.home_raw());
+        let target = |cell| OnlineTarget::Position {
+            cell,
+            velocity: 0.0,
+        };
+        let Ok(first) = plan_online(
+            &start,
+            &target(f.output_lsb(start.x) + ahead as i128),
+            &l,
+            OnlineOrder::Three,
+            &f,
+        ) else {
+            continue;
+        };
+        let k = rng.gen_range(1..first.program.total_ticks().max(2));
+        let mid = start.after_ticks(&first.program, k, &f.widths);
+        let Ok(back) = plan_online(
+            &mid,
+            &target(f.output_lsb(mid.x) - behind as i128),
+            &l,
+            OnlineOrder::Three,
+            &f,
+        ) else {
+            continue;
+        };
+        let (p1, _) = peaks(&first.program, &start);
+        let (p2, _) = peaks(&back.program, &mid);
+        let accel = p1.a.max(p2.a).as_i128();
+        let limits = StopLimits {
+            jerk: p1.j.max(p2.j).as_i128().min(accel),
+            accel,
+        };
+        if !limits.valid() {
+            continue;
+        }
+        let at = rng.gen_range(0..back.program.total_ticks().max(1));
+        let s = mid.after_ticks(&back.program, at, &f.widths);
+        let (trace, law) = stop_from(s, limits, 100_000_000);
+        stops += 1;
+        over += usize::from(law.over_limits());
+        assert_bound(&trace, s, limits);
+        for t in &trace {
+            assert!(
+                t.a.abs() <= limits.accel && t.j.abs() <= 2 * limits.accel,
+                "{t:?} from {s:?}"
+            );
+        }
+    }
+    assert!(stops > 2000, "{stops} stops");
+    assert!(
+        over > 50,
+        "only {over} states beyond a release at J: the case is not exercised"
+    );
 }

@@ -8,7 +8,7 @@
 //!
 //! The default virtual design runs a 1.5 MHz clock (what the simulation keeps up with in real
 //! time): 115 200 baud is 13 clocks per bit (115 385 baud, 0.16 % off), and Ts = 100 µs is 150
-//! clocks, long enough that the stop unit's decision (about 130 clocks) never makes a
+//! clocks, long enough that the stop unit's decision (about 140 clocks) never makes a
 //! stopping tick wait.
 
 use std::io::Write;

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long, default_value = "mixed")]
     order: OrderMix,
     /// Share of the moves given a controlled stop at a random clock (each stopping tick
-    /// takes the stop unit's decision, about 130 clocks).
+    /// takes the stop unit's decision, about 140 clocks).
     #[arg(long, default_value_t = DEFAULT_STOP_SHARE)]
     stop_share: f64,
     /// Share of the other moves replanned on the way: 1 to 8 program swaps at random
@@ -74,6 +74,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     cfg.fault = a.inject_fault.map(|s| parse_fault(&s)).transpose()?;
     let r = cosim(&cfg, a.bench)?;
     if r.mismatch.is_some()
+        || r.stops_not_at_rest > 0
         || r.planner_disagreements > 0
         || r.swap_faults() > 0
         || r.streams_diverged > 0
@@ -133,6 +134,18 @@ pub fn cosim(cfg: &CosimConfig, bench: bool) -> anyhow::Result<CosimReport> {
     if let Some(m) = &r.mismatch {
         println!("{m}");
     }
+    println!(
+        "controlled stops: {} ({} began outside their limits and landed within the bound, {} aborted on the way, {} timed out){}",
+        r.stopped,
+        r.stops_over,
+        r.stops_aborted,
+        r.stops_timed_out,
+        if r.stops_not_at_rest > 0 {
+            format!("; {} did not end at rest (must be 0)", r.stops_not_at_rest)
+        } else {
+            String::new()
+        }
+    );
     println!(
         "replans: {} program swaps played ({} drawn too long; refused by the online planner: {}), {} late swaps refused by the core, {} armed swaps cancelled by a stop{}",
         r.replans,

@@ -336,6 +336,12 @@ impl Executor {
             o.state = AxisState::ErrorStop;
             o.error = ErrorId::EmergencyStop;
         }
+        // A stop or an abort cancels an armed swap, and its program, planned for the swap's
+        // tick, never plays from another state: the standby bank is emptied.
+        if (o.command.stop || o.command.abort_move) && i.core.swap_pending {
+            o.command.count_enable = true;
+            o.command.count_value = 0;
+        }
 
         self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.core.ticks);
         self.out

@@ -48,7 +48,8 @@ pub enum Flag {
     V,
     /// The division's partial remainder is negative.
     Rs,
-    /// The level λ of the series sum is ≥ 0 (`D = 0`).
+    /// The level λ of the series sum is ≥ 0 (`D = 0`); in Decide, an Over stop releases at
+    /// once (`V + Λ > 0`).
     Zero,
     /// The next velocity is 0 (when the stop begins).
     Vz,
@@ -238,7 +239,11 @@ impl Derived {
             Derived::LevelGrid | Derived::ExcessGrid => brake && g(Flag::Bgt),
             Derived::LevelLimit | Derived::ExcessLimit => brake && !g(Flag::Bgt),
             Derived::LevelEnd => end,
-            Derived::NextBrake => below || (brake && g(Flag::Bgt)),
+            // An Over stop that releases at once (Zero in Decide) brakes within its limits
+            // from there.
+            Derived::NextBrake => {
+                below || (brake && g(Flag::Bgt)) || (g(Flag::Over) && g(Flag::Zero))
+            }
             Derived::NextHold => {
                 (brake && !g(Flag::Bgt))
                     || (release && !(g(Flag::Brake) && g(Flag::Above)) && at_limit && g(Flag::EhOk))

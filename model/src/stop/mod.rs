@@ -27,11 +27,18 @@
 //!
 //! `E ≥ 0` implies `V + Λ ≥ 0`, so the velocity never changes sign; from a state within the
 //! limits every branch keeps `|j| ≤ J` and `|a| ≤ A`; and the only way to end is the end game,
-//! which lands exactly. A state from which even an immediate release would reverse (`E < 0`
-//! when the stop begins: the move was decelerating harder than the stop's limits can release
-//! from in time) is brought to rest by the end game regardless of the limits. A stop whose
-//! next acceleration `Λ` (already decided when it begins) lies beyond `±A` runs outside `A`
-//! until it has stepped back within. Both are reported ([`StopLaw::over_limits`]).
+//! which lands exactly. A state from which a release at `J` would reverse (`E < 0` when the
+//! stop begins: the move was braking toward a reversal, harder than a release at `J` can undo
+//! in time) releases at once instead: the acceleration steps to zero on the first level the
+//! stop chooses (one tick's jerk of `|Λ|`), and the stop brakes within its limits from there;
+//! only a reversal the registers had already decided (`V + Λ < 0`) is landed by the end game
+//! (`|μ| < |Λ|`; and `V + Λ = 0`, with `μ = 0`). A stop whose next acceleration `Λ` (already decided when it begins) lies
+//! beyond `±A` runs outside `A` until it has stepped back within. Both are reported
+//! ([`StopLaw::over_limits`]).
+//!
+//! The bound, from any state: the stop ends exactly at rest; `|a| ≤ max(A, |Λ₀|)` on every
+//! tick; `|j| ≤ J` on every tick but the release's (`|Λ₀|`) and a decided reversal's landing
+//! (below `2|Λ₀|`); it never reverses but where the registers had already decided it.
 
 use ethnum::I256;
 use serde::{Deserialize, Serialize};
@@ -176,8 +183,20 @@ impl StopLaw {
 
     /// The next level, normalised.
     fn level(&mut self, vv: i128, lambda: i128, jm: i128, lo: i128) -> i128 {
-        // End game: land in two ticks.
         let mu = -(vv + lambda);
+        if self.over && mu < 0 {
+            // Even the fastest release at J would reverse, but the next velocity and
+            // acceleration do not (V + Λ > 0): the acceleration steps to zero at once (one
+            // tick's jerk of |Λ|, never a larger acceleration than the motion had), then the
+            // stop brakes within its limits from there (E = V + Λ: a release from level 0
+            // takes nothing off).
+            self.over = false;
+            self.excess = vv + lambda;
+            self.mode = StopMode::Brake;
+            return 0;
+        }
+        // End game: land in two ticks (from `over`: a reversal the registers had already
+        // decided, V + Λ < 0, where |μ| < |Λ|; or V + Λ = 0, where μ = 0).
         if self.over || (-jm <= mu && mu <= 0 && (mu - lambda).abs() <= jm) {
             self.mode = StopMode::End;
             return mu;

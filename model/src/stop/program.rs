@@ -342,11 +342,17 @@ fn build() -> Microprogram {
         c(I::new(Some(SVL), r(VV))
             .b(BMode::Add(L))
             .set(Flag::End, NotSign)),
-        c(I::new(Some(MU), ASrc::Zero).b(BMode::Sub(SVL))),
+        // Zero: the release of an Over stop applies (μ < 0, i.e. V + Λ > 0; ANDed with Over
+        // below).
+        c(I::new(Some(MU), ASrc::Zero)
+            .b(BMode::Sub(SVL))
+            .set(Flag::Zero, Sign)),
         c(I::new(None, r(MU))
             .b(BMode::Add(JL))
             .and(Flag::End, NotSign)),
-        c(I::new(Some(LEVEL), r(MU)).b(BMode::Sub(L))),
+        c(I::new(Some(LEVEL), r(MU))
+            .b(BMode::Sub(L))
+            .and(Flag::Zero, Test(Cond::Is(Flag::Over)))),
         c(I::new(None, r(LEVEL))
             .b(BMode::Add(JL))
             .and(Flag::End, NotSign)),
@@ -379,6 +385,9 @@ fn build() -> Microprogram {
         c(I::new(Some(E), r(EH)).when(Cond::When(Derived::ExcessHold))),
         c(I::new(Some(E), r(EG)).when(Cond::When(Derived::ExcessGrid))),
         c(I::new(Some(E), r(EP)).when(Cond::When(Derived::ExcessLimit))),
+        // Over with V + Λ > 0 (Zero, free in Decide): release at once to level 0, E = V + Λ.
+        c(I::new(Some(LEVEL), ASrc::Zero).when(Cond::Is(Flag::Zero))),
+        c(I::new(Some(E), r(SVL)).when(Cond::Is(Flag::Zero))),
         // The snap dir·(level − Λ) − j, and the mode (NB first: NextHold reads Brake).
         c(I::new(Some(T), r(LEVEL))
             .b(BMode::Sub(L))
@@ -388,6 +397,10 @@ fn build() -> Microprogram {
             .b(BMode::Sub(U))
             .to_snap()
             .set(Flag::Brake, Test(Cond::Is(Flag::NextBrake)))),
+        // After the release the law brakes within its limits (NextBrake has it): no longer Over.
+        c(I::new(None, ASrc::Zero)
+            .set(Flag::Over, Test(Cond::False))
+            .when(Cond::Is(Flag::Zero))),
         Instr::Halt,
     ]);
     let p = Microprogram {
