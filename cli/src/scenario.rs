@@ -129,5 +129,5 @@ impl Scenario {
 
 /// The output cell of a position in mm (the scenarios' unit) in `f`.
 pub fn cell_mm(mm: f64, f: &snapgen_model::Format) -> i128 {
-    snapgen_host::axis::compose::cell_of(mm, f)
+    snapgen_host::axis::cell_of(mm, f)
 }

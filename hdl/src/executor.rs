@@ -218,7 +218,7 @@ impl Executor {
 
 impl Default for Executor {
     fn default() -> Self {
-        Executor::new(crate::io_top::default_dividers(), 0)
+        Executor::new(crate::defaults::default_dividers(), 0)
     }
 }
 
@@ -409,7 +409,7 @@ mod tests {
 
     #[test]
     fn every_code_comes_from_the_protocol_table() {
-        let v = executor_verilog(&crate::io_top::default_dividers(), 0);
+        let v = executor_verilog(&crate::defaults::default_dividers(), 0);
         for c in COMMANDS {
             assert!(
                 v.contains(&format!("localparam [7:0] CMD_{} = 8'd{};", c.name, c.code)),

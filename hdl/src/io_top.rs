@@ -19,12 +19,12 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::device::Design;
-use snapgen_model::timing::{Dividers, Timing};
 use snapgen_spec::AxisState;
 
 use crate::block_with_ports;
 use crate::byte_fifo::ByteFifo;
 use crate::core::MotionCore;
+use crate::emit::{Note, Waiver};
 use crate::executor::Executor;
 use crate::frame_rx::FrameRx;
 use crate::input_filter::InputFilter;
@@ -36,7 +36,6 @@ use crate::servo::Servo;
 use crate::status_block::{FlagsWord, StatusBlock};
 use crate::uart_rx::UartRx;
 use crate::uart_tx::UartTx;
-use crate::verilog::{Note, Waiver};
 
 const _: () = assert!(
     crate::servo::REFERENCE_LOW == 64
@@ -89,27 +88,6 @@ const fn unused(signal: &'static str, reason: &'static str) -> Waiver {
     }
 }
 
-/// The dividers for 125 MHz, 115 200 baud and Ts = 10 µs (the Zybo Z7-10 defaults).
-pub fn default_dividers() -> Dividers {
-    Timing::default()
-        .dividers()
-        .expect("the default timing is valid")
-}
-
-/// The default design (the Zybo Z7-10's timing, the default format), with design hash 0:
-/// [`crate::verilog::io_design`] computes a design's real hash.
-pub fn default_design() -> Design {
-    let t = Timing::default();
-    Design {
-        format: snapgen_model::DEFAULT_FORMAT,
-        dividers: default_dividers(),
-        clock_hz: t.clock_hz as u32,
-        baud: t.baud,
-        design_hash: 0,
-        input_polarity: 0,
-    }
-}
-
 snapgen_spec::with_io_top_ports!(block_with_ports! {
     /// The I/O top; its ports are the spec's `with_io_top_ports!` list.
     pub struct IoTop(design: Design) {
@@ -154,7 +132,7 @@ impl IoTop {
 
 impl Default for IoTop {
     fn default() -> Self {
-        IoTop::new(default_design())
+        IoTop::new(crate::defaults::default_design())
     }
 }
 

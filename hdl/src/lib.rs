@@ -24,6 +24,8 @@ pub mod byte_fifo;
 pub mod chain;
 pub mod core;
 pub mod crc16;
+pub mod defaults;
+pub mod emit;
 pub mod executor;
 pub mod frame_rx;
 pub mod input_filter;
@@ -140,7 +142,7 @@ pub(crate) mod synth_check {
 
     use rust_hdl::prelude::Block;
 
-    /// Generates `uut`'s Verilog as `snapgen_NAME` (as [`crate::verilog::emit`] finishes every
+    /// Generates `uut`'s Verilog as `snapgen_NAME` (as [`crate::emit::emit`] finishes every
     /// design) and synthesises it for the 7 series; panics on a Yosys error or on any latch.
     /// Returns the `stat` text.
     pub fn synth_block<U: Block>(name: &str, uut: U) -> String {
@@ -152,7 +154,7 @@ pub(crate) mod synth_check {
             "swap_timer" => waivers.push(crate::verilog::SWAP_TIMER_WAIVER),
             _ => {}
         }
-        let verilog = crate::verilog::block_verilog(uut, &top, &waivers)
+        let verilog = crate::emit::block_verilog(uut, &top, &waivers)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let dir = std::env::temp_dir().join(format!("snapgen-synth-{}-{name}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -13,7 +13,7 @@
 
 use std::collections::BTreeMap;
 
-use crate::verilog::VerilogError;
+use crate::emit::VerilogError;
 
 /// One module of a file: its name and its lines (from `module` to `endmodule`).
 #[derive(Clone, Debug, PartialEq, Eq)]

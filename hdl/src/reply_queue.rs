@@ -8,7 +8,8 @@
 //! LUT-RAM on the 7 series); the model runs in rust-hdl's simulator.
 
 use rust_hdl::prelude::*;
-use snapgen_model::io::executor::{ReplyDesc, ReplyKind, ReplyQueue as QueueModel};
+use snapgen_model::io::executor::{ReplyDesc, ReplyKind};
+use snapgen_model::io::reply_queue::ReplyQueue as QueueModel;
 use snapgen_spec::rules::REPLY_QUEUE;
 
 use crate::protocol_v::KIND_BITS;

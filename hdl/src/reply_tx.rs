@@ -122,7 +122,7 @@ impl ReplyTx {
 
 impl Default for ReplyTx {
     fn default() -> Self {
-        ReplyTx::new(crate::io_top::default_design().identity())
+        ReplyTx::new(crate::defaults::default_design().identity())
     }
 }
 

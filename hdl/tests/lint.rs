@@ -4,7 +4,8 @@
 //! README's test command installs it).
 
 use rust_hdl::prelude::*;
-use snapgen_hdl::verilog::{block_verilog, Waiver, SEQUENCER_HINTS, SWAP_TIMER_WAIVER};
+use snapgen_hdl::emit::{block_verilog, Waiver};
+use snapgen_hdl::verilog::{SEQUENCER_HINTS, SWAP_TIMER_WAIVER};
 
 fn lint<U: Block>(name: &str, uut: U, extra: &[Waiver]) {
     let top = format!("snapgen_{name}");
@@ -89,7 +90,7 @@ fn every_block_lints_clean() {
 /// clean together.
 #[test]
 fn the_io_design_is_its_two_files_with_one_core() {
-    let design = snapgen_hdl::verilog::io_design(&snapgen_hdl::io_top::default_design());
+    let design = snapgen_hdl::verilog::io_design(&snapgen_hdl::defaults::default_design());
     let [(core_name, core), (io_name, io)] = snapgen_hdl::verilog::io_sources(&design);
     assert_eq!((core_name, io_name), ("snapgen_core.v", "snapgen_io.v"));
     assert!(

@@ -183,32 +183,6 @@ impl ChainState {
         })
     }
 
-    /// Plays `n` ticks of snap `d`, calling `visit` with the state after each tick: the same
-    /// states as `n` calls of [`ChainState::step`]. When the segment's registers provably stay
-    /// inside their widths (its exact extremes, checked once in closed form), nothing can wrap
-    /// and each tick is four plain additions; otherwise every tick wraps as the hardware does.
-    #[inline]
-    pub fn play(&self, d: i128, n: u64, w: &Widths, mut visit: impl FnMut(&ChainState)) -> Self {
-        let mut s = *self;
-        if n > 16 && wrap(d, w.d) == d && crate::peaks::segment_fits(self, d, n, w) {
-            for _ in 0..n {
-                s = ChainState {
-                    x: s.x + s.v,
-                    v: s.v + s.a,
-                    a: s.a + s.j,
-                    j: s.j + d,
-                };
-                visit(&s);
-            }
-        } else {
-            for _ in 0..n {
-                s = s.step(d, w);
-                visit(&s);
-            }
-        }
-        s
-    }
-
     /// Runs a whole program segment by segment in closed form and returns the final state.
     pub fn run_program(&self, program: &Program, w: &Widths) -> Self {
         program
@@ -369,27 +343,6 @@ mod tests {
         fn wrap_sign_extends_the_low_bits_at_every_width(value: i128, bits in 1u32..=128) {
             let s = 128 - bits;
             proptest::prop_assert_eq!(wrap(value, bits), (value << s) >> s);
-        }
-    }
-
-    proptest::proptest! {
-        /// `play` visits exactly the states of `step`, fast path or not (registers near
-        /// their limits included, so some segments wrap).
-        #[test]
-        fn play_equals_stepping(
-            d in -40i128..40, n in 0u64..200, v in -120i128..120, a in -60i128..60, j in -9i128..9,
-        ) {
-            let w = Widths { x: 20, v: 10, a: 8, j: 8, d: 8 };
-            let start = ChainState { x: 1000, v, a: wrap(a, 8), j };
-            let mut seen = Vec::new();
-            let end = start.play(d, n, &w, |s| seen.push(*s));
-            let mut s = start;
-            for (k, got) in seen.iter().enumerate() {
-                s = s.step(d, &w);
-                proptest::prop_assert_eq!(*got, s, "tick {}", k + 1);
-            }
-            proptest::prop_assert_eq!(end, s);
-            proptest::prop_assert_eq!(seen.len() as u64, n);
         }
     }
 

@@ -19,11 +19,12 @@
 
 use crate::core::{CoreInputs, CoreModel, CoreOutputs};
 use crate::format::Format;
-use crate::io::executor::{Executor, ExecutorInputs, ReplyQueue};
+use crate::io::executor::{Executor, ExecutorInputs};
 use crate::io::fifo::ByteFifo;
 use crate::io::frame_rx::{FrameRx, FrameRxInputs};
 use crate::io::pwm::{Pwm, PwmInputs};
 use crate::io::quadrature::{QuadInputs, QuadOutputs, Quadrature};
+use crate::io::reply_queue::ReplyQueue;
 use crate::io::reply_tx::{status, Live, ReplyTx, ReplyTxInputs, StatusInputs};
 use crate::io::servo::{Servo, ServoInputs};
 use crate::io::uart::{RxOutputs, UartRx, UartTx};

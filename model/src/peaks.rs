@@ -9,7 +9,7 @@
 
 use ethnum::I256;
 
-use crate::chain::{binomial, ChainState};
+use crate::chain::{binomial, wrap, ChainState};
 use crate::format::Widths;
 use crate::program::Program;
 
@@ -208,6 +208,36 @@ pub fn segment_fits(start: &ChainState, d: i128, n: u64, w: &Widths) -> bool {
     p.x <= max(w.x) && p.v <= max(w.v) && p.a <= max(w.a) && p.j <= max(w.j) && p.d <= max(w.d)
 }
 
+/// Playing a segment tick by tick, with the fast path the peaks allow (here, beside the
+/// closed-form extremes it needs, so that the chain does not depend on the peaks).
+impl ChainState {
+    /// Plays `n` ticks of snap `d`, calling `visit` with the state after each tick: the same
+    /// states as `n` calls of [`ChainState::step`]. When the segment's registers provably stay
+    /// inside their widths (its exact extremes, checked once in closed form), nothing can wrap
+    /// and each tick is four plain additions; otherwise every tick wraps as the hardware does.
+    #[inline]
+    pub fn play(&self, d: i128, n: u64, w: &Widths, mut visit: impl FnMut(&ChainState)) -> Self {
+        let mut s = *self;
+        if n > 16 && wrap(d, w.d) == d && segment_fits(self, d, n, w) {
+            for _ in 0..n {
+                s = ChainState {
+                    x: s.x + s.v,
+                    v: s.v + s.a,
+                    a: s.a + s.j,
+                    j: s.j + d,
+                };
+                visit(&s);
+            }
+        } else {
+            for _ in 0..n {
+                s = s.step(d, w);
+                visit(&s);
+            }
+        }
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -269,6 +299,26 @@ mod tests {
         assert_eq!(r.len(), 3);
         for (got, want) in r.iter().zip([1.0, 5.0, 9.0]) {
             assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+        }
+    }
+    proptest::proptest! {
+        /// `play` visits exactly the states of `step`, fast path or not (registers near
+        /// their limits included, so some segments wrap).
+        #[test]
+        fn play_equals_stepping(
+            d in -40i128..40, n in 0u64..200, v in -120i128..120, a in -60i128..60, j in -9i128..9,
+        ) {
+            let w = Widths { x: 20, v: 10, a: 8, j: 8, d: 8 };
+            let start = ChainState { x: 1000, v, a: wrap(a, 8), j };
+            let mut seen = Vec::new();
+            let end = start.play(d, n, &w, |s| seen.push(*s));
+            let mut s = start;
+            for (k, got) in seen.iter().enumerate() {
+                s = s.step(d, &w);
+                proptest::prop_assert_eq!(*got, s, "tick {}", k + 1);
+            }
+            proptest::prop_assert_eq!(end, s);
+            proptest::prop_assert_eq!(seen.len() as u64, n);
         }
     }
 }

@@ -27,6 +27,9 @@
 //! [`crate::link::Link`] (the device model, the Verilated board, a serial port).
 
 pub mod compose;
+mod part;
+
+pub use part::{cell_of, STOPPED_ON_TARGET};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

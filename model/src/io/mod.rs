@@ -9,6 +9,7 @@ pub mod fifo;
 pub mod frame_rx;
 pub mod pwm;
 pub mod quadrature;
+pub mod reply_queue;
 pub mod reply_tx;
 pub mod servo;
 pub mod uart;

@@ -1,149 +1,18 @@
-//! Runs a timed script of motion commands on a board over a [`Link`]: every change is
-//! planned from the exact state at a swap tick chosen ahead of the link's measured latency,
-//! uploaded and armed with SWAP_AT; every READ_STATE (one per poll) is compared bit for bit
-//! with the state the host predicts for its tick.
-//!
-//! The board's time base is the clock: a script's times count from the tick of its first
-//! READ_STATE. The latency of a command is the time from the tick it was due to the first tick
-//! that obeys it (its swap tick).
-
-use serde::{Deserialize, Serialize};
-use thiserror::Error;
+//! The driver's runner: the state of a run (the axis, the swap armed, the board's clock as
+//! the host knows it, the link's measured overhead) and what it does — polls compared with
+//! the prediction, changes planned and uploaded ahead of the link's latency (a head first, the
+//! rest as extensions), SWAP_ATs armed and retried when late.
 
 use crate::axis::compose::{Refusal, Request};
-use crate::axis::{AxisErrorId, AxisSettings, Goal, HostAxis, MotionCommand, Outcome};
-use crate::link::{Link, LinkError};
+use crate::axis::{AxisErrorId, Goal, HostAxis};
+use crate::link::Link;
 use crate::protocol::{Command, Reason, Reply, StateReply};
 use snapgen_model::chain::ChainState;
 use snapgen_model::program::Program;
 
-/// What a script event does.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum Action {
-    /// A motion command.
-    Command(MotionCommand),
-    /// The feed override (0–2).
-    Override {
-        /// Factor.
-        r#override: f64,
-    },
-}
+use super::{read_state, RunError, SwapRecord};
 
-/// One timed event.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Event {
-    /// Time from the script's start (ms).
-    pub at_ms: f64,
-    /// And, when given, not before the axis has reached this position (unit), moving toward
-    /// it from where the script began (a tangent move entering the buffer at a point).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub at_position: Option<f64>,
-    /// What happens.
-    #[serde(flatten)]
-    pub action: Action,
-}
-
-/// Run options.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RunOptions {
-    /// Status poll period (ms), also the watchdog's food.
-    pub poll_ms: f64,
-    /// Longest run after the last event (ms) before the run ends with commands still busy
-    /// (a held velocity).
-    pub settle_ms: f64,
-}
-
-impl Default for RunOptions {
-    fn default() -> Self {
-        RunOptions {
-            poll_ms: 2.0,
-            settle_ms: 10_000.0,
-        }
-    }
-}
-
-/// One program swap.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SwapRecord {
-    /// The events it realised (indices in the script; several when they were due together).
-    pub events: Vec<usize>,
-    /// The swap tick.
-    pub tick: u64,
-    /// Ticks from the first event's due tick to the swap tick: its latency.
-    pub latency_ticks: u64,
-    /// Segments uploaded.
-    pub segments: usize,
-    /// SWAP_AT refused as late before this one was taken.
-    pub late_retries: u32,
-}
-
-/// What a run did.
-#[derive(Clone, Debug)]
-pub struct RunReport {
-    /// The axis at the end (commands, outcomes, the timeline played).
-    pub axis: HostAxis,
-    /// Which command each event gave (None: an override).
-    pub event_commands: Vec<Option<usize>>,
-    /// The tick each event was due on: its time, or the tick the event before it was due if
-    /// later (events are taken in order), or the tick its position was seen reached; events
-    /// never taken (a position not reached) are missing at the end.
-    pub event_ticks: Vec<u64>,
-    /// Override events refused (event index, why).
-    pub refused_overrides: Vec<(usize, AxisErrorId)>,
-    /// Program swaps.
-    pub swaps: Vec<SwapRecord>,
-    /// The tick the script started on.
-    pub start_tick: u64,
-    /// The last READ_STATE.
-    pub last: StateReply,
-    /// READ_STATE replies compared with the prediction (all equal, or the run failed).
-    pub checks: u64,
-    /// Swaps that uploaded the rest of a change longer than the program memory.
-    pub extensions: u32,
-}
-
-/// Why a run stopped.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum RunError {
-    /// The link failed.
-    #[error("link: {0}")]
-    Link(#[from] LinkError),
-    /// The board answered what a run cannot go on from.
-    #[error("the board answered {what}: {detail}")]
-    Board {
-        /// The command.
-        what: &'static str,
-        /// The answer.
-        detail: String,
-    },
-    /// The board's registers differ from the host's prediction (a stop was sent).
-    #[error("the board's registers at tick {tick} are {got:?}, the plan says {want:?}: stopped")]
-    Diverged {
-        /// The tick.
-        tick: u64,
-        /// Read.
-        got: Box<ChainState>,
-        /// Predicted.
-        want: Box<ChainState>,
-    },
-    /// The axis was moving when the script began.
-    #[error("the axis is moving (v, a or j ≠ 0): start a script at rest")]
-    Moving,
-}
-
-/// Reads the state.
-pub fn read_state<L: Link>(link: &mut L) -> Result<StateReply, RunError> {
-    match link.ask(&Command::ReadState)? {
-        Reply::State(s) => Ok(s),
-        r => Err(RunError::Board {
-            what: "READ_STATE",
-            detail: format!("{r:?}"),
-        }),
-    }
-}
-
-fn regs(s: &StateReply) -> ChainState {
+pub(super) fn regs(s: &StateReply) -> ChainState {
     ChainState {
         x: s.x,
         v: s.v,
@@ -153,11 +22,11 @@ fn regs(s: &StateReply) -> ChainState {
 }
 
 /// Ticks in `ms` milliseconds at Ts.
-fn ticks_of(ms: f64, ts: f64) -> u64 {
+pub(super) fn ticks_of(ms: f64, ts: f64) -> u64 {
     (ms * 1e-3 / ts).round().max(0.0) as u64
 }
 
-fn too_slow() -> RunError {
+pub(super) fn too_slow() -> RunError {
     RunError::Board {
         what: "SWAP_AT",
         detail: "LATE again and again: the link is too slow for the swaps this script needs".into(),
@@ -165,28 +34,28 @@ fn too_slow() -> RunError {
 }
 
 /// Ticks of lead beyond the upload's estimate.
-const SAFETY: u64 = 20;
+pub(super) const SAFETY: u64 = 20;
 
 /// Bytes of `c`'s frame.
-fn frame_bytes(c: &Command, f: &snapgen_model::format::Format) -> usize {
+pub(super) fn frame_bytes(c: &Command, f: &snapgen_model::format::Format) -> usize {
     c.to_frame(0, f).to_bytes().len()
 }
 
 /// The frames a run sends and reads, in bytes (fixed by the format: computed once).
 #[derive(Clone, Copy, Debug)]
-struct FrameBytes {
+pub(super) struct FrameBytes {
     /// READ_STATE and its STATE reply.
-    read: usize,
+    pub(super) read: usize,
     /// The STATE reply alone.
-    state: usize,
+    pub(super) state: usize,
     /// One LOAD_SEGMENT and its ACK.
-    load: usize,
+    pub(super) load: usize,
     /// COMMIT, SWAP_AT and their ACKs.
-    arm: usize,
+    pub(super) arm: usize,
 }
 
 impl FrameBytes {
-    fn of(f: &snapgen_model::format::Format, s: StateReply) -> Self {
+    pub(super) fn of(f: &snapgen_model::format::Format, s: StateReply) -> Self {
         let ack = Reply::Ack { cmd: 0 }.to_frame(0).to_bytes().len();
         let state = Reply::State(s).to_frame(0).to_bytes().len();
         let load = Command::LoadSegment {
@@ -207,68 +76,68 @@ impl FrameBytes {
 /// The first upload's sizes a change tries, fewest first (segments; the last is the whole
 /// program memory): a head of the change goes up and is swapped to, the rest follows as
 /// extensions while it plays (docs/ONLINE.md, "How a change is made").
-const HEADS: [usize; 7] = [6, 8, 10, 12, 16, 24, usize::MAX];
+pub(super) const HEADS: [usize; 7] = [6, 8, 10, 12, 16, 24, usize::MAX];
 
 /// The first `n` segments of `p`.
-fn head(p: &Program, n: usize) -> Program {
+pub(super) fn head(p: &Program, n: usize) -> Program {
     Program {
         segments: p.segments[..n.min(p.segments.len())].to_vec(),
     }
 }
 
 /// SWAP_AT attempts before a command is given up as the link being too slow.
-const LATE_TRIES: u32 = 8;
+pub(super) const LATE_TRIES: u32 = 8;
 
-struct Runner<'l, L: Link> {
-    link: &'l mut L,
+pub(super) struct Runner<'l, L: Link> {
+    pub(super) link: &'l mut L,
     /// The board's tick (s): the driver counts in ticks, the link in seconds.
-    ts: f64,
-    axis: HostAxis,
-    checks: u64,
-    last: StateReply,
+    pub(super) ts: f64,
+    pub(super) axis: HostAxis,
+    pub(super) checks: u64,
+    pub(super) last: StateReply,
     /// Host ticks a request takes beyond its bytes on the wire, the largest seen.
-    overhead: f64,
+    pub(super) overhead: f64,
     /// The armed swap's tick, until it has passed.
-    armed: Option<u64>,
+    pub(super) armed: Option<u64>,
     /// The tick the board's program (as armed) ends on.
-    covered: u64,
+    pub(super) covered: u64,
     /// Swaps that only uploaded the rest of a long change.
-    extensions: u32,
+    pub(super) extensions: u32,
     /// Ticks between polls.
-    poll_ticks: u64,
+    pub(super) poll_ticks: u64,
     /// The host's clock when the last READ_STATE's reply had come.
-    polled: f64,
+    pub(super) polled: f64,
     /// That reply's ticks on the wire.
-    reply_wire: f64,
+    pub(super) reply_wire: f64,
     /// Host ticks the longest planning of a change took (0 on a virtual board, whose clock
     /// stands still while the host computes).
-    planning: u64,
+    pub(super) planning: u64,
     /// Frame sizes.
-    bytes: FrameBytes,
+    pub(super) bytes: FrameBytes,
     /// The last tick the upload of the rest of the running change may wait past
     /// ([`Runner::defer_deadline`]), once found; cleared when the board's program or the
     /// timeline changes.
-    defer_until: Option<u64>,
+    pub(super) defer_until: Option<u64>,
 }
 
 impl<L: Link> Runner<'_, L> {
     /// The host's clock in board ticks.
-    fn host_ticks(&self) -> f64 {
+    pub(super) fn host_ticks(&self) -> f64 {
         self.link.now() / self.ts
     }
 
     /// Board ticks one byte takes on the wire.
-    fn byte_ticks(&self) -> f64 {
+    pub(super) fn byte_ticks(&self) -> f64 {
         self.link.byte_time() / self.ts
     }
 
     /// Lets `ticks` board ticks pass.
-    fn wait_ticks(&mut self, ticks: u64) {
+    pub(super) fn wait_ticks(&mut self, ticks: u64) {
         self.link.wait(ticks as f64 * self.ts);
     }
 
     /// READ_STATE, compared with the prediction; the axis's outcomes updated.
-    fn poll(&mut self) -> Result<StateReply, RunError> {
+    pub(super) fn poll(&mut self) -> Result<StateReply, RunError> {
         let t0 = self.host_ticks();
         let s = read_state(self.link)?;
         self.polled = self.host_ticks();
@@ -296,7 +165,7 @@ impl<L: Link> Runner<'_, L> {
         Ok(s)
     }
 
-    fn expect_ack(&mut self, c: &Command) -> Result<Result<(), Reason>, RunError> {
+    pub(super) fn expect_ack(&mut self, c: &Command) -> Result<Result<(), Reason>, RunError> {
         match self.link.ask(c)? {
             Reply::Ack { .. } => Ok(Ok(())),
             Reply::Nak { reason, .. } => Ok(Err(reason)),
@@ -310,7 +179,7 @@ impl<L: Link> Runner<'_, L> {
     /// Plans, uploads and arms the requests due together (events `events`, the first due on
     /// tick `due`): the swap's record (None when none was needed) and the requests refused.
     #[allow(clippy::type_complexity)]
-    fn change(
+    pub(super) fn change(
         &mut self,
         events: &[usize],
         due: u64,
@@ -462,7 +331,7 @@ impl<L: Link> Runner<'_, L> {
 
     /// Uploads `program` and arms its swap at `at`: `Err(())` when SWAP_AT came too late
     /// (nothing changed on the board).
-    fn arm(
+    pub(super) fn arm(
         &mut self,
         at: u64,
         program: &snapgen_model::program::Program,
@@ -502,7 +371,7 @@ impl<L: Link> Runner<'_, L> {
     }
 
     /// True when the timeline goes on past the program the board holds.
-    fn needs_extension(&self) -> bool {
+    pub(super) fn needs_extension(&self) -> bool {
         let f = self.axis.settings.format;
         !self
             .axis
@@ -517,7 +386,12 @@ impl<L: Link> Runner<'_, L> {
     /// followed, once its swap has passed and been seen
     /// ([`Runner::seen_ticks`] later), by the upload of the rest (as [`Runner::extend`] leads
     /// it) armed before the board has played what it holds.
-    fn coverable(&self, timeline: &crate::axis::Timeline, at: u64, first: usize) -> bool {
+    pub(super) fn coverable(
+        &self,
+        timeline: &crate::axis::Timeline,
+        at: u64,
+        first: usize,
+    ) -> bool {
         let f = self.axis.settings.format;
         let mut swap = at;
         let mut most = first.min(f.max_segments);
@@ -548,7 +422,7 @@ impl<L: Link> Runner<'_, L> {
     /// before the head ends, as [`Runner::defer_deadline`] has it) for as long as another such
     /// head takes to go up, so a command that comes meanwhile does not wait behind it. A head
     /// of the whole change always does.
-    fn roomy(&self, timeline: &crate::axis::Timeline, at: u64, first: usize) -> bool {
+    pub(super) fn roomy(&self, timeline: &crate::axis::Timeline, at: u64, first: usize) -> bool {
         let f = self.axis.settings.format;
         let rest = timeline.segments_from(at, &f);
         if rest.len() <= first {
@@ -569,7 +443,7 @@ impl<L: Link> Runner<'_, L> {
     /// at twice the lead), when from there it still fits ([`Runner::extension_fits`]) and every
     /// later upload still follows in time ([`Runner::coverable`] from the latest swap that
     /// leaves); else `tick − 1`: at once.
-    fn defer_deadline(&self, tick: u64) -> u64 {
+    pub(super) fn defer_deadline(&self, tick: u64) -> u64 {
         let f = self.axis.settings.format;
         let at_once = tick.saturating_sub(1);
         // What the upload will carry: from the segment playing then on, at most the program
@@ -600,7 +474,7 @@ impl<L: Link> Runner<'_, L> {
 
     /// Whether the rest of the running change, uploaded a poll after `tick`, is armed before
     /// the board has played what it holds.
-    fn extension_fits(&self, tick: u64) -> bool {
+    pub(super) fn extension_fits(&self, tick: u64) -> bool {
         self.extension_swap(tick + self.seen_ticks(), 1.0) < self.covered
     }
 
@@ -608,7 +482,7 @@ impl<L: Link> Runner<'_, L> {
     /// be swapped to with `margin`: the first `at` whose upload (the timeline's program from
     /// `at`) takes no more than `at − tick` as [`Runner::lead`] has it. A later swap carries
     /// fewer segments, so the condition, once met, holds on: found by bisection.
-    fn extension_swap(&self, tick: u64, margin: f64) -> u64 {
+    pub(super) fn extension_swap(&self, tick: u64, margin: f64) -> u64 {
         let f = self.axis.settings.format;
         let fits = |at: u64| {
             let n = self.axis.timeline.segments_from(at, &f).len();
@@ -639,7 +513,7 @@ impl<L: Link> Runner<'_, L> {
     /// the program memory), uploads the rest and swaps to it before the board's ends: at
     /// once when `now`, else when it can wait no longer ([`Runner::defer_deadline`]), the
     /// standby bank free meanwhile (a change that comes makes this upload moot).
-    fn extend(&mut self, now: bool) -> Result<(), RunError> {
+    pub(super) fn extend(&mut self, now: bool) -> Result<(), RunError> {
         let f = self.axis.settings.format;
         let mut margin = 1.0;
         for _ in 0..LATE_TRIES {
@@ -673,7 +547,7 @@ impl<L: Link> Runner<'_, L> {
 
     /// The board's tick now, as the host knows it: the last READ_STATE's tick, and the ticks
     /// since (its reply's time on the wire, and the host's clock since it came).
-    fn board_now(&self) -> u64 {
+    pub(super) fn board_now(&self) -> u64 {
         let since = self.reply_wire + (self.host_ticks() - self.polled).max(0.0);
         self.last.ticks + since.ceil() as u64
     }
@@ -681,7 +555,7 @@ impl<L: Link> Runner<'_, L> {
     /// Host ticks from a swap to the end of the poll that sees it has passed, at the most: a
     /// poll period, and two READ_STATE round trips (the one under way when the swap passes
     /// reads the tick before it).
-    fn seen_ticks(&self) -> u64 {
+    pub(super) fn seen_ticks(&self) -> u64 {
         let round_trip = self.bytes.read as f64 * self.byte_ticks() + self.overhead;
         self.poll_ticks + (2.0 * round_trip).ceil() as u64
     }
@@ -689,24 +563,24 @@ impl<L: Link> Runner<'_, L> {
     /// Host ticks the upload of `n` segments takes: LOAD_SEGMENTs, COMMIT and SWAP_AT with
     /// their acknowledgements on the wire ([`Runner::upload_wire`]), and the measured overhead
     /// per request.
-    fn upload_ticks(&self, n: usize) -> f64 {
+    pub(super) fn upload_ticks(&self, n: usize) -> f64 {
         self.upload_wire(n) + (n + 2) as f64 * self.overhead
     }
 
     /// Host ticks the frames of an upload of `n` segments take on the wire.
-    fn upload_wire(&self, n: usize) -> f64 {
+    pub(super) fn upload_wire(&self, n: usize) -> f64 {
         (n * self.bytes.load + self.bytes.arm) as f64 * self.byte_ticks()
     }
 
     /// The lead a swap of an upload of `n` segments is armed with: its time
     /// ([`Runner::upload_ticks`]) with a quarter more, times `margin` (doubled after each
     /// NAK LATE), and [`SAFETY`].
-    fn lead(&self, n: usize, margin: f64) -> u64 {
+    pub(super) fn lead(&self, n: usize, margin: f64) -> u64 {
         (self.upload_ticks(n) * 1.25 * margin).ceil() as u64 + SAFETY
     }
 
     /// True when nothing will move any more without a new command.
-    fn settled(&self, now: u64) -> bool {
+    pub(super) fn settled(&self, now: u64) -> bool {
         let t = &self.axis.timeline;
         now >= t.end_tick()
             && self.armed.is_none()
@@ -714,151 +588,4 @@ impl<L: Link> Runner<'_, L> {
                 .last()
                 .is_none_or(|p| !matches!(p.goal, Goal::Velocity(v) if v != 0.0))
     }
-}
-
-/// Runs `script` (events in time order) on the board behind `link`, which must be powered,
-/// at rest and configured (stop limits) for the axis's format.
-pub fn run<L: Link>(
-    link: &mut L,
-    settings: AxisSettings,
-    script: &[Event],
-    opts: &RunOptions,
-) -> Result<RunReport, RunError> {
-    let first = read_state(link)?;
-    if (first.v, first.a, first.j) != (0, 0, 0) {
-        return Err(RunError::Moving);
-    }
-    let ts = settings.format.ts;
-    let mut r = Runner {
-        link,
-        ts,
-        axis: HostAxis::new(settings, first.ticks, regs(&first)),
-        checks: 0,
-        last: first,
-        overhead: 0.0,
-        armed: None,
-        covered: first.ticks,
-        extensions: 0,
-        poll_ticks: ticks_of(opts.poll_ms, ts).max(1),
-        polled: 0.0,
-        reply_wire: 0.0,
-        planning: 0,
-        defer_until: None,
-        bytes: FrameBytes::of(&settings.format, first),
-    };
-    let start = first.ticks;
-    let f = settings.format;
-    let home = f.position_physical(first.x);
-    let mut swaps = Vec::new();
-    let mut event_commands = Vec::new();
-    let mut refused_overrides = Vec::new();
-    let mut event_ticks = Vec::new();
-    let mut next = 0;
-    let last_due = script
-        .last()
-        .map_or(start, |e| start + ticks_of(e.at_ms, ts));
-    // A position trigger never reached ends the run at the settle time after the last event.
-    let end_by = last_due + ticks_of(opts.settle_ms, ts);
-    loop {
-        r.poll()?;
-        let now = r.last.ticks;
-        let here = f.position_physical(r.last.x);
-        let is_due = |e: &Event| {
-            let reached = e.at_position.is_none_or(|p| {
-                let toward = (p - home).signum();
-                (here - p) * toward >= 0.0
-            });
-            start + ticks_of(e.at_ms, ts) <= now && reached
-        };
-        // The rest of a long change goes up when it can wait no longer, unless a change is due
-        // (which replaces it, or uploads it first when it must: `Runner::change`).
-        if !script.get(next).is_some_and(is_due) {
-            r.extend(false)?;
-        }
-        if let Some(e) = script.get(next) {
-            if is_due(e) {
-                // Every event due by now, planned together. Events are taken in order: one is
-                // due at its time, or when the event before it was due if that is later (held
-                // back behind a position trigger); a position trigger is due on the tick it was
-                // seen reached.
-                let released = |e: &Event, before: u64| {
-                    if e.at_position.is_some() {
-                        now
-                    } else {
-                        (start + ticks_of(e.at_ms, ts)).max(before)
-                    }
-                };
-                let first = next;
-                let mut reqs = Vec::new();
-                while let Some(e) = script.get(next) {
-                    if !is_due(e) {
-                        break;
-                    }
-                    let before = event_ticks.last().copied().unwrap_or(start);
-                    event_ticks.push(released(e, before));
-                    match e.action {
-                        Action::Command(c) => {
-                            let k = r.axis.submit(c);
-                            event_commands.push(Some(k));
-                            if !r.axis.commands[k].outcome.is_final() {
-                                reqs.push((next, Request::Command(k)));
-                            }
-                        }
-                        Action::Override { r#override } => {
-                            event_commands.push(None);
-                            reqs.push((next, Request::Override(r#override)));
-                        }
-                    }
-                    next += 1;
-                }
-                if reqs.is_empty() {
-                    continue;
-                }
-                let only: Vec<Request> = reqs.iter().map(|(_, q)| *q).collect();
-                let events: Vec<usize> = reqs.iter().map(|(e, _)| *e).collect();
-                let due = event_ticks[events[0]];
-                let (swap, refused) = r.change(&events, due, &only)?;
-                swaps.extend(swap);
-                // A refused command is in Error; a refused override changes nothing.
-                for (q, refusal) in refused {
-                    match q {
-                        Request::Command(k) => {
-                            r.axis.commands[k].outcome = Outcome::Error(refusal.error)
-                        }
-                        Request::Override(_) => {
-                            let ev = reqs
-                                .iter()
-                                .find(|(_, x)| *x == q)
-                                .map_or(first, |(e, _)| *e);
-                            refused_overrides.push((ev, refusal.error))
-                        }
-                    }
-                }
-                continue;
-            }
-            if now >= end_by {
-                // A position never reached: the events from here are not played.
-                break;
-            }
-            let wait = (start + ticks_of(e.at_ms, ts)).saturating_sub(now);
-            r.wait_ticks(r.poll_ticks.min(wait).max(1));
-            continue;
-        }
-        if r.settled(now) || now >= end_by {
-            break;
-        }
-        r.wait_ticks(r.poll_ticks);
-    }
-    r.poll()?;
-    Ok(RunReport {
-        checks: r.checks,
-        extensions: r.extensions,
-        last: r.last,
-        axis: r.axis,
-        event_commands,
-        event_ticks,
-        refused_overrides,
-        swaps,
-        start_tick: start,
-    })
 }

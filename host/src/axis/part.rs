@@ -1,0 +1,327 @@
+//! Planning one part of a change: a command's inputs checked, the online plan from the exact
+//! state its part begins at to its goal (a position at rest, a blend point, a velocity), and
+//! the velocity a blend passes its target at.
+
+use snapgen_model::chain::ChainState;
+use snapgen_model::format::{Format, Quantity};
+use snapgen_model::program::{Program, Segment};
+use snapgen_plan::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
+
+use super::{scaled, AxisErrorId, BufferMode, Goal, HostAxis, MotionCommand};
+
+impl HostAxis {
+    /// The velocity the timeline's last part would pass its target at with command `next`
+    /// blending into it (0: no blend, a reversal, or not a position move).
+    pub(super) fn blend_at_last(&self, next: usize) -> f64 {
+        let Some(last) = self.timeline.parts.last() else {
+            return 0.0;
+        };
+        let (Goal::Position { cell, .. }, MotionCommand::MoveAbsolute { velocity, .. }) =
+            (last.goal, self.commands[last.command].command)
+        else {
+            return 0.0;
+        };
+        let f = &self.settings.format;
+        let dist = cell - f.output_lsb(last.start.x);
+        blend_velocity(dist, cell, velocity, &self.commands[next].command, f)
+    }
+}
+
+/// The first `n` ticks of `p`.
+pub(super) fn prefix(p: &Program, n: u64) -> Program {
+    let mut left = n;
+    let mut segments = Vec::new();
+    for s in &p.segments {
+        if left == 0 {
+            break;
+        }
+        let t = left.min(u64::from(s.ticks));
+        segments.push(Segment {
+            ticks: t as u32,
+            snap: s.snap,
+        });
+        left -= t;
+    }
+    Program { segments }
+}
+
+/// Inputs every command needs: finite, positive limits; a position the register holds.
+pub(super) fn check_inputs(c: &MotionCommand, f: &Format) -> Result<(), AxisErrorId> {
+    let positive = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(AxisErrorId::InvalidInput(format!(
+                "{} {name} = {v}: give a finite value > 0",
+                c.name()
+            )))
+        }
+    };
+    match *c {
+        MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..
+        } => {
+            positive("velocity", velocity)?;
+            positive("acceleration", acceleration)?;
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+            let most = f.physical_max(Quantity::Position) * 0.5;
+            if !position.is_finite() || position.abs() > most {
+                return Err(AxisErrorId::InvalidInput(format!(
+                    "MC_MoveAbsolute position = {position}: give a position within ±{most:.6} (half the position register)"
+                )));
+            }
+        }
+        MotionCommand::MoveVelocity {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+        } => {
+            if !velocity.is_finite() {
+                return Err(AxisErrorId::InvalidInput(format!(
+                    "MC_MoveVelocity velocity = {velocity}: give a finite value"
+                )));
+            }
+            positive("acceleration", acceleration)?;
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+        }
+        MotionCommand::Halt { deceleration, jerk } => {
+            positive("deceleration", deceleration)?;
+            positive("jerk", jerk)?;
+        }
+    }
+    Ok(())
+}
+
+type Planned = (Program, ChainState, Goal, bool, Option<String>);
+
+/// The note of a move whose stop on the path (override 0) would have come to rest on or past
+/// its target: it stops on the target instead.
+pub const STOPPED_ON_TARGET: &str =
+    "override 0 too near the target to stop before it: stopped on it";
+
+/// Plans one command's part from `from` with override `k`: a position move to its target at
+/// rest or at the blend velocity with `next`, a velocity, a halt.
+pub(super) fn plan_part(
+    cmd: &MotionCommand,
+    next: Option<&MotionCommand>,
+    from: &ChainState,
+    k: f64,
+    axis: &HostAxis,
+) -> Result<Planned, OnlineError> {
+    let f = &axis.settings.format;
+    let order = axis.settings.order;
+    let run = |target: OnlineTarget, limits: OnlineLimits| {
+        plan_online(from, &target, &limits, order, f).map(|p| (p.program, p.final_state))
+    };
+    // A stop on the path (override 0, MC_Halt) with the command's deceleration.
+    let stop = |l: OnlineLimits| run(OnlineTarget::Velocity(0.0), l);
+    match *cmd {
+        MotionCommand::Halt { deceleration, jerk } => {
+            let l = OnlineLimits {
+                velocity: f.physical_max(Quantity::Velocity),
+                acceleration: deceleration,
+                deceleration,
+                jerk,
+            };
+            let (p, e) = stop(l)?;
+            Ok((p, e, Goal::Velocity(0.0), false, None))
+        }
+        MotionCommand::MoveVelocity {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+        } => {
+            let l = OnlineLimits {
+                velocity: if k > 0.0 {
+                    velocity.abs() * k
+                } else {
+                    velocity.abs()
+                },
+                acceleration,
+                deceleration,
+                jerk,
+            };
+            let v = velocity * k;
+            let (p, e) = if velocity == 0.0 {
+                stop(OnlineLimits {
+                    velocity: f.physical_max(Quantity::Velocity),
+                    ..l
+                })?
+            } else {
+                run(OnlineTarget::Velocity(v), l)?
+            };
+            Ok((p, e, Goal::Velocity(v), k == 0.0, None))
+        }
+        MotionCommand::MoveAbsolute {
+            position,
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..
+        } => {
+            let l = OnlineLimits {
+                velocity,
+                acceleration,
+                deceleration,
+                jerk,
+            };
+            let cell = cell_of(position, f);
+            let here = f.output_lsb(from.x);
+            if k == 0.0 {
+                // A stop on the path, unless it would come to rest on or past the target
+                // (the axis would then have to come back): the move ends on its target
+                // instead, braking as it would have.
+                let (p, e) = stop(l)?;
+                let dir = if from.v != 0 {
+                    from.v.signum()
+                } else {
+                    (cell - here).signum()
+                };
+                if (f.output_lsb(e.x) - cell) * dir < 0 {
+                    return Ok((p, e, Goal::Velocity(0.0), true, None));
+                }
+                let (p, e) = run(
+                    OnlineTarget::Position {
+                        cell,
+                        velocity: 0.0,
+                    },
+                    l,
+                )?;
+                let goal = Goal::Position {
+                    cell,
+                    velocity: 0.0,
+                };
+                return Ok((p, e, goal, false, Some(STOPPED_ON_TARGET.into())));
+            }
+            let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
+            let l = scaled(l, k);
+            let vb = vb * k;
+            let l = OnlineLimits {
+                velocity: l.velocity.max(vb.abs()),
+                ..l
+            };
+            let at = |v: f64| OnlineTarget::Position { cell, velocity: v };
+            // The blend given up: to rest on the target, the next move from there.
+            let buffered = || {
+                let (p, e) = run(at(0.0), l)?;
+                Ok((
+                    p,
+                    e,
+                    Goal::Position {
+                        cell,
+                        velocity: 0.0,
+                    },
+                    false,
+                    Some("blend not reachable before the blend point: buffered instead".into()),
+                ))
+            };
+            let blend = |v: f64| {
+                let l = OnlineLimits {
+                    velocity: l.velocity.max(v.abs()),
+                    ..l
+                };
+                run(at(v), l)
+            };
+            match run(at(vb), l) {
+                Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
+                Err(OnlineError::BlendUnreachable) if vb != 0.0 => {
+                    // Too fast to slow to the blend velocity by the blend point (an override
+                    // cut on a short move): the lowest blend velocity that can be reached, up
+                    // to the speed the axis reaches releasing its acceleration at full jerk
+                    // (seed 002 eq 32), found to 1/64 of the way; else as buffered.
+                    let to = |q, r: i128| f.to_physical(q, r);
+                    let (v, a) = (
+                        to(Quantity::Velocity, from.v),
+                        to(Quantity::Acceleration, from.a),
+                    );
+                    let release = match axis.settings.order {
+                        OnlineOrder::Three => a * a.abs() / (2.0 * jerk),
+                        OnlineOrder::Two => 0.0,
+                    };
+                    let reached = (v + release).abs().max(v.abs());
+                    let mut hi = reached.max(vb.abs() * (1.0 + 1.0 / 64.0));
+                    let mut found = blend(hi * vb.signum()).ok().map(|r| (hi, r));
+                    if found.is_some() {
+                        let mut lo = vb.abs();
+                        for _ in 0..6 {
+                            let mid = 0.5 * (lo + hi);
+                            match blend(mid * vb.signum()) {
+                                Ok(r) => {
+                                    hi = mid;
+                                    found = Some((mid, r));
+                                }
+                                Err(_) => lo = mid,
+                            }
+                        }
+                    }
+                    match found {
+                        Some((v, (p, e))) => Ok((
+                            p,
+                            e,
+                            Goal::Position {
+                                cell,
+                                velocity: v * vb.signum(),
+                            },
+                            false,
+                            Some(format!(
+                                "the blend velocity {:.3} could not be reached before the blend point: passed at {v:.3} instead",
+                                vb.abs()
+                            )),
+                        )),
+                        None => buffered(),
+                    }
+                }
+                Err(OnlineError::NotRealisable(_)) if vb != 0.0 => buffered(),
+                Err(e) => Err(e),
+            }
+        }
+    }
+}
+
+/// The output cell of a position (unit).
+pub fn cell_of(position: f64, f: &Format) -> i128 {
+    snapgen_plan::planner::fmath::round(position / f.position_lsb) as i128
+}
+
+/// The velocity a move (`dist` cells toward its target `cell`, velocity `v`) passes its
+/// target at when `next` blends into it: per `next`'s BufferMode, signed as the motion, 0
+/// when the next move reverses, stands still or is not a blending move.
+pub(super) fn blend_velocity(
+    dist: i128,
+    cell: i128,
+    v: f64,
+    next: &MotionCommand,
+    f: &Format,
+) -> f64 {
+    let MotionCommand::MoveAbsolute {
+        position,
+        velocity: vn,
+        buffer_mode,
+        ..
+    } = *next
+    else {
+        return 0.0;
+    };
+    let onward = cell_of(position, f) - cell;
+    if dist == 0 || onward == 0 || dist.signum() != onward.signum() {
+        return 0.0;
+    }
+    let m = match buffer_mode {
+        BufferMode::BlendingLow => v.min(vn),
+        BufferMode::BlendingPrevious => v,
+        BufferMode::BlendingNext => vn,
+        BufferMode::BlendingHigh => v.max(vn),
+        BufferMode::Aborting | BufferMode::Buffered => 0.0,
+    };
+    m * dist.signum() as f64
+}
