@@ -1,12 +1,14 @@
-// snapgen co-simulation harness: the Verilated motion core behind a small C API, built into a
-// shared library that snapgen-sim loads. One call runs many clocks and writes every clock's
-// outputs into a caller's buffer, so the comparison with the model costs no pipe traffic.
+// snapgen co-simulation harness: a Verilated design — the motion core (behind the input
+// registers of sim/src/wrapper.rs) or the I/O top — behind a small C API, built into a shared
+// library that snapgen-sim loads (sim/src/verilated.rs). One call runs many clocks, with the
+// inputs held (snapgen_sim_run) or each clock's own (snapgen_sim_run_each), and writes every
+// clock's outputs into the caller's buffer, so the comparison with the model costs no pipe
+// traffic.
 //
-// The word layouts of the inputs and of each clock's outputs, and the functions that copy
-// them, are generated from the port tables of snapgen-sim (sim/src/fabric.rs) into
-// snapgen_layout.h.
+// snapgen_layout.h is generated from the design's port tables (sim/src/layout.rs): the word
+// layouts of the inputs and of a clock's outputs, the functions that copy them, the inputs at
+// rest (SNAPGEN_IDLE) and the ABI word the loader checks (SNAPGEN_ABI).
 #include <cstdint>
-#include <cstring>
 #include "Vtop.h"
 #include "verilated.h"
 #include "Vtop___024root.h"
@@ -25,7 +27,7 @@ void Vtop___024root___eval(Vtop___024root* vlSelf);
 #define SNAPGEN_EVAL(t) Vtop___024root___eval((t)->rootp)
 #endif
 
-struct Core {
+struct Sim {
     VerilatedContext* ctx;
     Vtop* top;
 #if SNAPGEN_TRACE
@@ -36,74 +38,87 @@ struct Core {
     uint64_t vcd_to;
 };
 
-static void dump(Core* c, uint64_t t) {
+static void dump(Sim* s, uint64_t t) {
 #if SNAPGEN_TRACE
-    if (c->vcd && c->cycle >= c->vcd_from && c->cycle <= c->vcd_to) c->vcd->dump(t);
+    if (s->vcd && s->cycle >= s->vcd_from && s->cycle <= s->vcd_to) s->vcd->dump(t);
 #else
-    (void)c;
+    (void)s;
     (void)t;
 #endif
 }
 
+// One clock: the rising edge, the outputs after it, the falling edge.
+static inline void clock(Sim* s, uint32_t* out) {
+    Vtop* t = s->top;
+    t->clock = 1;
+    SNAPGEN_EVAL(t);
+    dump(s, 2 * s->cycle + 1);
+    snapgen_get(t, out);
+    t->clock = 0;
+    SNAPGEN_EVAL(t);
+    s->cycle++;
+    dump(s, 2 * s->cycle);
+}
+
 extern "C" {
 
-uint32_t snapgen_core_abi(void) { return (SNAPGEN_IN_WORDS << 8) | SNAPGEN_OUT_WORDS; }
+uint32_t snapgen_sim_abi(void) { return SNAPGEN_ABI; }
 
-void* snapgen_core_new(const char* vcd_path, uint64_t vcd_from, uint64_t vcd_to) {
-    Core* c = new Core();
-    c->ctx = new VerilatedContext();
-    c->top = new Vtop(c->ctx);
-    c->cycle = 0;
-    c->vcd_from = vcd_from;
-    c->vcd_to = vcd_to;
+void* snapgen_sim_new(const char* vcd_path, uint64_t vcd_from, uint64_t vcd_to) {
+    Sim* s = new Sim();
+    s->ctx = new VerilatedContext();
+    s->top = new Vtop(s->ctx);
+    s->cycle = 0;
+    s->vcd_from = vcd_from;
+    s->vcd_to = vcd_to;
 #if SNAPGEN_TRACE
-    c->vcd = nullptr;
+    s->vcd = nullptr;
     if (vcd_path && *vcd_path) {
-        c->ctx->traceEverOn(true);
-        c->vcd = new VerilatedVcdC();
-        c->top->trace(c->vcd, 99);
-        c->vcd->open(vcd_path);
+        s->ctx->traceEverOn(true);
+        s->vcd = new VerilatedVcdC();
+        s->top->trace(s->vcd, 99);
+        s->vcd->open(vcd_path);
     }
 #else
     (void)vcd_path;
 #endif
-    c->top->clock = 0;
-    c->top->eval();
-    return c;
+    snapgen_set(s->top, SNAPGEN_IDLE);
+    s->top->clock = 0;
+    s->top->eval();
+    return s;
 }
 
-void snapgen_core_free(void* h) {
-    Core* c = static_cast<Core*>(h);
+void snapgen_sim_free(void* h) {
+    Sim* s = static_cast<Sim*>(h);
 #if SNAPGEN_TRACE
-    if (c->vcd) {
-        c->vcd->close();
-        delete c->vcd;
+    if (s->vcd) {
+        s->vcd->close();
+        delete s->vcd;
     }
 #endif
-    c->top->final();
-    delete c->top;
-    delete c->ctx;
-    delete c;
+    s->top->final();
+    delete s->top;
+    delete s->ctx;
+    delete s;
 }
 
-void snapgen_core_set(void* h, const uint32_t* in) {
-    snapgen_set(static_cast<Core*>(h)->top, in);
+// Applies inputs (SNAPGEN_IN_WORDS words), held until changed.
+void snapgen_sim_set(void* h, const uint32_t* in) { snapgen_set(static_cast<Sim*>(h)->top, in); }
+
+// Runs n clocks with the inputs held; out receives SNAPGEN_OUT_WORDS words per clock, sampled
+// after each rising edge.
+void snapgen_sim_run(void* h, uint64_t n, uint32_t* out) {
+    Sim* s = static_cast<Sim*>(h);
+    for (uint64_t i = 0; i < n; ++i) clock(s, out + i * SNAPGEN_OUT_WORDS);
 }
 
-// Runs n rising clock edges with the inputs last set; out receives SNAPGEN_OUT_WORDS words per clock,
-// sampled after each rising edge.
-void snapgen_core_run(void* h, uint64_t n, uint32_t* out) {
-    Core* c = static_cast<Core*>(h);
-    Vtop* t = c->top;
+// Runs n clocks: clock i takes the inputs in[i * SNAPGEN_IN_WORDS ..] before its rising edge and
+// writes the outputs after it to out[i * SNAPGEN_OUT_WORDS ..].
+void snapgen_sim_run_each(void* h, uint64_t n, const uint32_t* in, uint32_t* out) {
+    Sim* s = static_cast<Sim*>(h);
     for (uint64_t i = 0; i < n; ++i) {
-        t->clock = 1;
-        SNAPGEN_EVAL(t);
-        dump(c, 2 * c->cycle + 1);
-        snapgen_get(t, out + i * SNAPGEN_OUT_WORDS);
-        t->clock = 0;
-        SNAPGEN_EVAL(t);
-        c->cycle++;
-        dump(c, 2 * c->cycle);
+        snapgen_set(s->top, in + i * SNAPGEN_IN_WORDS);
+        clock(s, out + i * SNAPGEN_OUT_WORDS);
     }
 }
 

@@ -30,10 +30,8 @@ use std::process::Command;
 
 use crate::SimError;
 
-/// The harness source of core co-simulation builds.
+/// The harness source of every build (the motion core's and the I/O top's).
 pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
-/// The harness source of virtual-board builds (the I/O top).
-pub const IO_HARNESS_CPP: &str = include_str!("../harness/io_harness.cpp");
 
 /// C++ flags of every build (see the module documentation).
 const CFLAGS: &str = "-fPIC -march=native -fno-semantic-interposition";
@@ -140,7 +138,7 @@ pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
         "io",
         snapgen_hdl::verilog::IO_PREFIX,
         io_verilog,
-        IO_HARNESS_CPP,
+        HARNESS_CPP,
         &crate::io::io_layout_header(),
         trace,
     )

@@ -1,12 +1,13 @@
-//! The Verilated core, loaded from the shared library that [`crate::build`] makes.
+//! The Verilated motion core: its port tables and word layout (from the spec's port list),
+//! and its instance, loaded through [`crate::verilated`].
 
-use std::ffi::{c_char, c_void, CString};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use libloading::Library;
 use snapgen_model::{CoreInputs, CoreOutputs};
 
 use crate::layout::{harness_header, pack, Port, PortValue, Slot};
+pub use crate::verilated::VcdWindow;
+use crate::verilated::{abi, Verilated};
 use crate::SimError;
 
 /// The core's port tables, encoders and decoders, from the spec's port list: one slot per
@@ -74,112 +75,36 @@ pub const IN_WORDS: usize = IN_LAYOUT.1;
 /// Output words per clock.
 pub const OUT_WORDS: usize = OUT_LAYOUT.1;
 
-/// The core harness's generated header (`snapgen_layout.h`).
+/// The core harness's generated header (`snapgen_layout.h`): the inputs at rest are the
+/// core's defaults.
 pub fn core_layout_header() -> String {
-    harness_header(&CORE_INPUTS, &CORE_OUTPUTS)
+    harness_header(
+        &CORE_INPUTS,
+        &CORE_OUTPUTS,
+        abi(CORE_TAG, IN_WORDS, OUT_WORDS),
+        &encode_inputs(&CoreInputs::default()),
+    )
 }
 
-type NewFn = unsafe extern "C" fn(*const c_char, u64, u64) -> *mut c_void;
-type FreeFn = unsafe extern "C" fn(*mut c_void);
-type SetFn = unsafe extern "C" fn(*mut c_void, *const u32);
-type RunFn = unsafe extern "C" fn(*mut c_void, u64, *mut u32);
-type AbiFn = unsafe extern "C" fn() -> u32;
+/// The motion core's tag in the harness's ABI word.
+const CORE_TAG: u32 = 1;
 
-/// One instance of the Verilated core.
-pub struct Fabric {
-    handle: *mut c_void,
-    free: FreeFn,
-    set: SetFn,
-    run: RunFn,
-    // Declared last: dropped after the instance is freed.
-    _lib: Library,
-}
-
-// The instance is only ever used from the thread that owns the `Fabric`.
-unsafe impl Send for Fabric {}
-
-/// Where to write waves, and which clocks.
-#[derive(Clone, Debug)]
-pub struct VcdWindow {
-    /// The VCD file.
-    pub path: PathBuf,
-    /// First clock dumped.
-    pub from: u64,
-    /// Last clock dumped.
-    pub to: u64,
-}
+/// One instance of the Verilated core (behind its input registers, [`crate::wrapper`]).
+pub struct Fabric(Verilated);
 
 impl Fabric {
     /// Loads `library` and creates one core; with `vcd`, the library must be a trace build.
     pub fn open(library: &Path, vcd: Option<&VcdWindow>) -> Result<Self, SimError> {
-        let load_err = |reason: String| SimError::Load {
-            path: library.to_path_buf(),
-            reason,
-        };
-        // SAFETY: the library is one that `build` made from our own harness; its symbols have
-        // the types declared above (checked through `snapgen_core_abi`).
-        unsafe {
-            let lib = Library::new(library).map_err(|e| load_err(e.to_string()))?;
-            let abi: AbiFn = *lib
-                .get::<AbiFn>(b"snapgen_core_abi\0")
-                .map_err(|e| load_err(e.to_string()))?;
-            let want = ((IN_WORDS as u32) << 8) | OUT_WORDS as u32;
-            if abi() != want {
-                return Err(load_err(format!(
-                    "harness ABI {:#x}, expected {want:#x}",
-                    abi()
-                )));
-            }
-            let new: NewFn = *lib
-                .get::<NewFn>(b"snapgen_core_new\0")
-                .map_err(|e| load_err(e.to_string()))?;
-            let free: FreeFn = *lib
-                .get::<FreeFn>(b"snapgen_core_free\0")
-                .map_err(|e| load_err(e.to_string()))?;
-            let set: SetFn = *lib
-                .get::<SetFn>(b"snapgen_core_set\0")
-                .map_err(|e| load_err(e.to_string()))?;
-            let run: RunFn = *lib
-                .get::<RunFn>(b"snapgen_core_run\0")
-                .map_err(|e| load_err(e.to_string()))?;
-            let (path, from, to) = match vcd {
-                Some(w) => (
-                    CString::new(w.path.to_string_lossy().as_bytes())
-                        .map_err(|_| load_err("VCD path contains a NUL byte".into()))?,
-                    w.from,
-                    w.to,
-                ),
-                None => (CString::default(), 0, 0),
-            };
-            let handle = new(path.as_ptr(), from, to);
-            Ok(Fabric {
-                handle,
-                free,
-                set,
-                run,
-                _lib: lib,
-            })
-        }
+        Verilated::open(library, vcd, CORE_TAG, IN_WORDS, OUT_WORDS).map(Fabric)
     }
 
     /// Applies inputs (held until the next call).
     pub fn set(&mut self, i: &CoreInputs) {
-        let words = encode_inputs(i);
-        // SAFETY: `handle` is a live instance; `words` has IN_WORDS words.
-        unsafe { (self.set)(self.handle, words.as_ptr()) }
+        self.0.set(&encode_inputs(i));
     }
 
     /// Runs `n` clocks; `out` receives `n * OUT_WORDS` words.
     pub fn run(&mut self, n: usize, out: &mut Vec<u32>) {
-        out.resize(n * OUT_WORDS, 0);
-        // SAFETY: `out` holds room for n clocks of OUT_WORDS words.
-        unsafe { (self.run)(self.handle, n as u64, out.as_mut_ptr()) }
-    }
-}
-
-impl Drop for Fabric {
-    fn drop(&mut self) {
-        // SAFETY: `handle` came from `snapgen_core_new` and is freed once.
-        unsafe { (self.free)(self.handle) }
+        self.0.run(n, out);
     }
 }

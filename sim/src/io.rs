@@ -1,19 +1,16 @@
-//! The Verilated I/O top (`snapgen_io`), loaded from the shared library [`crate::build`] makes
-//! with `harness/io_harness.cpp`: one call runs many clocks with every clock's pins in and
-//! every clock's outputs out. Its port tables are the single source of the harness's word
+//! The Verilated I/O top (`snapgen_io`), loaded through [`crate::verilated`]: one call runs
+//! many clocks with every clock's pins in and every clock's outputs out. Its port tables are the single source of the harness's word
 //! layout (`snapgen_layout.h`) and of the Rust encoders and decoders below; its outputs are
 //! compared with `snapgen_model::device::Device` on every clock ([`crate::io_cosim`]) and drive
 //! the virtual board ([`crate::board`]).
 
-use std::ffi::{c_char, c_void, CString};
 use std::path::Path;
 
-use libloading::Library;
 use snapgen_model::device::{IoInputs, IoOutputs};
 use snapgen_spec::fields::{Status, STATUS_BITS, STATUS_FIELDS};
 
-use crate::fabric::VcdWindow;
 use crate::layout::{harness_header, pack, Port, Slot};
+use crate::verilated::{abi, VcdWindow, Verilated};
 use crate::SimError;
 
 /// The I/O top's port tables, encoders and decoder, from the spec's port list (one slot per
@@ -111,7 +108,17 @@ const _: () = assert!(IO_OUTPUTS[STATUS_PORT].bits as usize == STATUS_BITS);
 
 /// The harness's generated header (`snapgen_layout.h`).
 pub fn io_layout_header() -> String {
-    harness_header(&IO_INPUTS, &IO_OUTPUTS)
+    // At rest the UART line idles high (and every other pin is low).
+    let idle = IoInputs {
+        uart_rx: true,
+        ..Default::default()
+    };
+    harness_header(
+        &IO_INPUTS,
+        &IO_OUTPUTS,
+        abi(IO_TAG, IN_WORDS, OUT_WORDS),
+        &encode_inputs(&idle),
+    )
 }
 
 /// A compared output: a pin, or a field of the status block.
@@ -204,90 +211,21 @@ pub fn first_difference(got: &[u32], want: &[u32]) -> Option<(IoSignal, u128, u1
         .map(|s| (s, s.value(want), s.value(got)))
 }
 
-type NewFn = unsafe extern "C" fn(*const c_char, u64, u64) -> *mut c_void;
-type FreeFn = unsafe extern "C" fn(*mut c_void);
-type RunFn = unsafe extern "C" fn(*mut c_void, u64, *const u32, *mut u32);
-type AbiFn = unsafe extern "C" fn() -> u32;
+/// The I/O top's tag in the harness's ABI word.
+const IO_TAG: u32 = 2;
 
 /// One Verilated I/O top.
-pub struct FabricIo {
-    handle: *mut c_void,
-    free: FreeFn,
-    run: RunFn,
-    // Declared last: dropped after the instance is freed.
-    _lib: Library,
-}
-
-// The instance is only ever used from the thread that owns it.
-unsafe impl Send for FabricIo {}
+pub struct FabricIo(Verilated);
 
 impl FabricIo {
     /// Loads `library` and creates one I/O top; with `vcd`, the library must be a trace build.
     pub fn open(library: &Path, vcd: Option<&VcdWindow>) -> Result<Self, SimError> {
-        let err = |reason: String| SimError::Load {
-            path: library.to_path_buf(),
-            reason,
-        };
-        // SAFETY: the library was built by `build_io` from our own io_harness.cpp; its symbols
-        // have the types declared above (checked through `snapgen_io_abi`).
-        unsafe {
-            let lib = Library::new(library).map_err(|e| err(e.to_string()))?;
-            let abi: AbiFn = *lib
-                .get::<AbiFn>(b"snapgen_io_abi\0")
-                .map_err(|e| err(e.to_string()))?;
-            let want = 0x20000 | ((IN_WORDS as u32) << 8) | OUT_WORDS as u32;
-            if abi() != want {
-                return Err(err(format!("harness ABI {:#x}, expected {want:#x}", abi())));
-            }
-            let new: NewFn = *lib
-                .get(b"snapgen_io_new\0")
-                .map_err(|e| err(e.to_string()))?;
-            let free: FreeFn = *lib
-                .get(b"snapgen_io_free\0")
-                .map_err(|e| err(e.to_string()))?;
-            let run: RunFn = *lib
-                .get(b"snapgen_io_run\0")
-                .map_err(|e| err(e.to_string()))?;
-            let (path, from, to) = match vcd {
-                Some(w) => (
-                    CString::new(w.path.to_string_lossy().as_bytes())
-                        .map_err(|_| err("VCD path contains a NUL byte".into()))?,
-                    w.from,
-                    w.to,
-                ),
-                None => (CString::default(), 0, 0),
-            };
-            let handle = new(path.as_ptr(), from, to);
-            Ok(FabricIo {
-                handle,
-                free,
-                run,
-                _lib: lib,
-            })
-        }
+        Verilated::open(library, vcd, IO_TAG, IN_WORDS, OUT_WORDS).map(FabricIo)
     }
 
     /// Runs one clock per entry of `ins`; `outs` receives `OUT_WORDS` words a clock.
     pub fn run(&mut self, ins: &[[u32; IN_WORDS]], outs: &mut Vec<u32>) {
-        let n = ins.len();
-        outs.resize(n * OUT_WORDS, 0);
-        // SAFETY: `ins` holds n clocks of IN_WORDS words, contiguous; `outs` has room for n
-        // clocks of outputs.
-        unsafe {
-            (self.run)(
-                self.handle,
-                n as u64,
-                ins.as_ptr().cast::<u32>(),
-                outs.as_mut_ptr(),
-            )
-        }
-    }
-}
-
-impl Drop for FabricIo {
-    fn drop(&mut self) {
-        // SAFETY: the handle came from snapgen_io_new and is freed once.
-        unsafe { (self.free)(self.handle) }
+        self.0.run_each(ins.as_flattened(), outs);
     }
 }
 

@@ -23,6 +23,7 @@ pub mod io_cosim;
 pub mod layout;
 pub mod moves;
 pub mod vcd;
+pub mod verilated;
 pub mod wrapper;
 
 use std::path::PathBuf;
