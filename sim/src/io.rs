@@ -77,7 +77,9 @@ impl Packed for bool {
 
 impl Packed for Status {
     fn pack(self, slot: &Slot, w: &mut [u32]) {
-        for (k, b) in self.to_payload().into_iter().enumerate() {
+        let mut bytes = [0u8; Status::BYTES];
+        self.write_payload(&mut bytes);
+        for (k, b) in bytes.into_iter().enumerate() {
             w[slot.word + k / 4] |= u32::from(b) << (8 * (k % 4));
         }
     }

@@ -139,12 +139,18 @@ macro_rules! payload {
             pub const BYTES: usize = $crate::fields::payload_bytes(&$table);
 
             /// The payload.
-            #[allow(clippy::unnecessary_cast)]
             pub fn to_payload(&self) -> Vec<u8> {
                 let mut p = vec![0u8; Self::BYTES];
-                let mut fields = $table.iter();
-                $( $crate::fields::put(&mut p, fields.next().expect("one field each"), self.$field as i128); )*
+                self.write_payload(&mut p);
                 p
+            }
+
+            /// The payload written into `p` (at least [`Self::BYTES`] bytes, zeroed), without
+            /// an allocation.
+            #[allow(clippy::unnecessary_cast)]
+            pub fn write_payload(&self, p: &mut [u8]) {
+                let mut fields = $table.iter();
+                $( $crate::fields::put(p, fields.next().expect("one field each"), self.$field as i128); )*
             }
 
             /// From a payload of exactly [`Self::BYTES`] bytes.

@@ -17,6 +17,12 @@ use crate::fabric::{encode, Fabric, OUT_WORDS};
 /// stay in the L1/L2 cache between being written and compared.
 pub const BATCH: u64 = 1 << 9;
 
+/// Where a clock's inputs come from: held for the whole call, or given clock by clock.
+enum Source<'s> {
+    Held(CoreInputs),
+    Each(&'s mut dyn FnMut(&CoreOutputs) -> CoreInputs),
+}
+
 /// The model's side of the lockstep.
 pub struct ModelSide {
     /// The core model.
@@ -102,8 +108,7 @@ impl Lockstep {
 
     /// `n` clocks with inputs `i` on both sides, compared.
     pub fn drive(&mut self, i: &CoreInputs, n: u64) -> Result<(), Mismatch> {
-        let i = *i;
-        self.run(n, &mut |_| i)
+        self.clocks(n, Source::Held(*i))
     }
 
     /// `n` clocks, each with the inputs `source` gives from the model's outputs before it,
@@ -113,12 +118,17 @@ impl Lockstep {
         n: u64,
         source: &mut dyn FnMut(&CoreOutputs) -> CoreInputs,
     ) -> Result<(), Mismatch> {
+        self.clocks(n, Source::Each(source))
+    }
+
+    fn clocks(&mut self, n: u64, mut source: Source<'_>) -> Result<(), Mismatch> {
         let mut left = n;
         while left > 0 {
             let cap = left.min(BATCH) as usize;
-            let inputs = match self.carry.take() {
-                Some(i) => i,
-                None => source(&self.side.model.outputs()),
+            let inputs = match (self.carry.take(), &mut source) {
+                (Some(i), _) => i,
+                (None, Source::Held(i)) => *i,
+                (None, Source::Each(f)) => f(&self.side.model.outputs()),
             };
             let Some(fab) = self.fabric.as_mut() else {
                 // The model alone.
@@ -132,10 +142,12 @@ impl Lockstep {
                     if k == cap {
                         break;
                     }
-                    let next = source(&self.side.model.outputs());
-                    if next != inputs {
-                        self.carry = Some(next);
-                        break;
+                    if let Source::Each(f) = &mut source {
+                        let next = f(&self.side.model.outputs());
+                        if next != inputs {
+                            self.carry = Some(next);
+                            break;
+                        }
                     }
                 }
                 left -= k as u64;
@@ -153,10 +165,12 @@ impl Lockstep {
                 if k == cap {
                     break;
                 }
-                let next = source(&self.side.model.outputs());
-                if next != inputs {
-                    self.carry = Some(next);
-                    break;
+                if let Source::Each(f) = &mut source {
+                    let next = f(&self.side.model.outputs());
+                    if next != inputs {
+                        self.carry = Some(next);
+                        break;
+                    }
                 }
             }
             // The fabric, the same clocks.
