@@ -2,8 +2,9 @@
 //! (`snapgen_plant::Plant`) through its PWM, direction and amplifier-enable pins and reads the
 //! motor's encoder, while the device model, fed the same pins on every clock, must produce the
 //! same outputs — PWM, direction, amplifier, the UART and the whole status block — on every
-//! clock. A host on the UART configures the axis, uploads programs and starts them, as
-//! `snapgen send` does.
+//! clock. The host's own code on the UART (`snapgen_host`: a session over this loop as its
+//! byte medium, [`Transport`]) configures the axis, reads it back, uploads programs and starts
+//! them, as `snapgen send` does.
 //!
 //! Clock by clock, one plant step at a time: the pins of the step's clocks (the host's UART
 //! line, the encoder heading for the plant's count, the index) are known before it (the plant
@@ -12,7 +13,9 @@
 //! and the motor is integrated. Without the fabric (`fabric: false`) the model drives the
 //! motor: the same loop, model only.
 
-use snapgen_host::protocol::{Command, Decoded, Decoder, Param, Reason, Reply};
+use snapgen_host::link::{FramedLink, LinkError, RetryPolicy, Transport};
+use snapgen_host::protocol::{Command, Param};
+use snapgen_host::session::{Failure, HostError, Session};
 use snapgen_model::device::{Design, Device, IoInputs, IoOutputs};
 use snapgen_model::io::servo::ServoConfig;
 use snapgen_model::peer::Peer;
@@ -51,25 +54,16 @@ pub enum LoopError {
     /// The plant's step.
     #[error(transparent)]
     Step(#[from] StepError),
-    /// No reply from the device.
-    #[error("no reply to {0} within {1} s of simulated time")]
-    NoReply(String, f64),
-    /// The device refused a command.
-    #[error("the device refused {command}: {}", reason.name())]
-    Nak {
-        /// The command.
-        command: String,
-        /// Why.
-        reason: Reason,
-    },
-    /// An unexpected reply.
-    #[error("unexpected reply to {command}: {reply:?}")]
-    Unexpected {
-        /// The command.
-        command: String,
-        /// The reply.
-        reply: Box<Reply>,
-    },
+    /// The host's session with the board (the link, a refusal, a configuration that did not
+    /// read back).
+    #[error(transparent)]
+    Host(#[from] Failure),
+}
+
+impl From<HostError> for LoopError {
+    fn from(e: HostError) -> Self {
+        LoopError::Host(Failure::Host(e))
+    }
 }
 
 /// The axis's configuration for a closed loop.
@@ -91,9 +85,8 @@ pub struct ClosedLoop {
     peer: Peer,
     plant: Plant,
     rad_per_count: f64,
-    seq: u8,
-    decoder: Decoder,
-    replies: Vec<(u8, Reply)>,
+    /// Bytes the host has received from the board and not read yet.
+    received: Vec<u8>,
     inputs: Vec<IoInputs>,
     words: Vec<[u32; IN_WORDS]>,
     outs: Vec<u32>,
@@ -137,9 +130,7 @@ impl ClosedLoop {
             peer,
             rad_per_count: p.rad_per_count(),
             plant,
-            seq: 0,
-            decoder: Decoder::new(),
-            replies: Vec::new(),
+            received: Vec::new(),
             inputs: Vec::new(),
             words: Vec::new(),
             outs: Vec::new(),
@@ -277,15 +268,7 @@ impl ClosedLoop {
             }
         }
         self.peer.drive_encoder(self.plant.count());
-        for b in self.peer.take_received() {
-            if let Some(Decoded::Frame(f)) = self.decoder.push(b) {
-                if let Some(r) = Reply::from_frame(&f) {
-                    if !matches!(r, Reply::Telemetry(_)) {
-                        self.replies.push((f.seq, r));
-                    }
-                }
-            }
-        }
+        self.received.extend(self.peer.take_received());
     }
 
     fn record(&mut self, o: &IoOutputs) {
@@ -303,68 +286,76 @@ impl ClosedLoop {
         });
     }
 
-    /// Sends `c` and runs until its reply (at most a second of simulated time).
-    pub fn ask(&mut self, c: Command) -> Result<Reply, LoopError> {
-        self.seq = self.seq.wrapping_add(1).max(1);
-        let seq = self.seq;
-        self.peer
-            .send(&c.to_frame(seq, &self.design.format).to_bytes());
-        let deadline = self.clock + u64::from(self.design.clock_hz);
-        while self.clock < deadline {
-            self.step();
-            if let Some(k) = self.replies.iter().position(|(s, _)| *s == seq) {
-                return match self.replies.remove(k).1 {
-                    Reply::Nak { reason, .. } => Err(LoopError::Nak {
-                        command: c.name().to_string(),
-                        reason,
-                    }),
-                    r => Ok(r),
-                };
-            }
-        }
-        Err(LoopError::NoReply(c.name().to_string(), 1.0))
-    }
-
-    /// Sends `c`, which must be acknowledged.
-    pub fn command(&mut self, c: Command) -> Result<(), LoopError> {
-        match self.ask(c)? {
-            Reply::Ack { .. } => Ok(()),
-            r => Err(LoopError::Unexpected {
-                command: c.name().to_string(),
-                reply: Box::new(r),
-            }),
-        }
+    /// A session of the host with the board (PING, the board's format; `snapgen_host`'s own
+    /// code over this loop as its byte medium, with the one retry policy).
+    pub fn host(&mut self) -> Result<Session<FramedLink<&mut ClosedLoop>>, Failure> {
+        let lsb = self.design.format.position_lsb;
+        Session::open(FramedLink::new(self, RetryPolicy::default(), 1), lsb)
     }
 
     /// Configures the axis (PWM, controller, stop limits; the watchdog off: the loop's host
     /// polls at its own pace) and powers it.
     pub fn setup(&mut self, s: &AxisSetup) -> Result<(), LoopError> {
-        let head = [
-            (Param::WatchdogMs, 0),
-            (Param::PwmPeriod, i128::from(s.pwm_period)),
-        ];
-        let stop = [
-            (Param::StopJerk, s.stop.jerk),
-            (Param::StopAccel, s.stop.accel),
-        ];
-        let servo = s.servo.writes();
-        for &(param, value) in head.iter().chain(&servo).chain(&stop) {
-            self.command(Command::Configure { param, value })?;
+        let mut host = self.host()?;
+        // WATCHDOG_MS and PWM_PERIOD go without a read-back, as they always did here: every
+        // read-back moves the first move's start by a frame time, and from some start phases
+        // the tuned loop settles into a stick-slip limit cycle of about ±5 counts (found while
+        // moving this loop onto the one host; left to the motor-tuning issue). The tests keep
+        // the start phase they have always had.
+        let write = |param, value| Command::Configure { param, value };
+        host.expect_ack(&write(Param::WatchdogMs, 0))?;
+        host.expect_ack(&write(Param::PwmPeriod, i128::from(s.pwm_period)))?;
+        for (param, value) in s.servo.writes() {
+            host.configure(param, value)?;
         }
-        self.command(Command::Power { on: true })
+        host.power_up(s.stop)?;
+        Ok(())
     }
 
     /// Uploads `program` and starts it.
     pub fn start(&mut self, program: &Program) -> Result<(), LoopError> {
+        let mut host = self.host()?;
         for (k, s) in program.segments.iter().enumerate() {
-            self.command(Command::LoadSegment {
+            host.expect_ack(&Command::LoadSegment {
                 index: k as u8,
                 segment: *s,
             })?;
         }
-        self.command(Command::Commit {
+        host.expect_ack(&Command::Commit {
             count: program.segments.len() as u8,
         })?;
-        self.command(Command::Start)
+        host.expect_ack(&Command::Start)?;
+        Ok(())
+    }
+}
+
+/// The loop as the host's byte medium: bytes go over the board's UART at its baud rate, and
+/// time is the loop's own (its clocks, the motor integrated meanwhile).
+impl Transport for ClosedLoop {
+    fn write(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.peer.send(bytes);
+        Ok(())
+    }
+
+    fn read(&mut self, wait: f64, out: &mut Vec<u8>) -> Result<(), LinkError> {
+        let until = self.time() + wait.max(0.0);
+        while self.received.is_empty() && self.time() < until {
+            self.step();
+        }
+        out.append(&mut self.received);
+        Ok(())
+    }
+
+    fn now(&self) -> f64 {
+        self.time()
+    }
+
+    fn sleep(&mut self, seconds: f64) {
+        let t = self.time() + seconds.max(0.0);
+        self.run_until(t);
+    }
+
+    fn byte_time(&self) -> f64 {
+        10.0 * f64::from(self.design.dividers.uart_divisor) / f64::from(self.design.clock_hz)
     }
 }

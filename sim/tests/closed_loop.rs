@@ -7,6 +7,7 @@ use std::f64::consts::PI;
 
 use snapgen_host::protocol::Reason;
 use snapgen_host::protocol::{flag, AxisState, Command, ErrorId, Reply};
+use snapgen_host::session::HostError;
 use snapgen_model::device::Design;
 use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
@@ -16,7 +17,7 @@ use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
 use snapgen_plant::metrics::{figures, MoveSpan};
 use snapgen_plant::PlantParams;
-use snapgen_sim::closed_loop::{AxisSetup, ClosedLoop, LoopError};
+use snapgen_sim::closed_loop::{AxisSetup, ClosedLoop};
 use snapgen_sim::io::IoSignal;
 
 /// A small design: 2 MHz, 250 000 baud, Ts = 50 µs (100 clocks), 20 kHz PWM (100 clocks), a
@@ -101,7 +102,7 @@ fn moves_on_the_fabric_match_the_model_and_track() {
     for plan in [&out, &back] {
         l.start(&plan.program).unwrap();
         l.run_until(l.starts().last().unwrap() + plan.ticks_total() as f64 * f.ts + 0.3);
-        let Reply::State(st) = l.ask(Command::ReadState).unwrap() else {
+        let Reply::State(st) = l.host().unwrap().request(&Command::ReadState).unwrap() else {
             panic!()
         };
         assert_eq!((st.x, st.v, st.a, st.j), (plan.final_state.x, 0, 0, 0));
@@ -179,7 +180,7 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     .unwrap();
     l.start(&plan.program).unwrap();
     l.run_until(l.time() + 0.5);
-    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
         panic!()
     };
     assert_eq!(
@@ -192,8 +193,8 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     l.run_until(l.time() + 0.5);
     let rest = l.plant().state();
     assert_eq!(rest.current, 0.0);
-    match l.ask(Command::Start) {
-        Err(LoopError::Nak { reason, .. }) => assert_eq!(reason, Reason::AxisError),
+    match l.host().unwrap().request(&Command::Start) {
+        Err(HostError::Nak { reason, .. }) => assert_eq!(reason, Reason::AxisError),
         r => panic!("{r:?}"),
     }
     l.run_until(l.time() + 0.2);
@@ -202,32 +203,41 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     // tick on every clock the controller's first sample falls on the clock POWER is taken:
     // it must see the loaded reference, not the one the motor coasted away from (which is
     // past the following limit and would trip the fault again at once).
-    l.command(Command::Configure {
-        param: snapgen_host::protocol::Param::TickDivider,
-        value: 0,
-    })
-    .unwrap();
-    l.command(Command::Reset).unwrap();
-    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+    l.host()
+        .unwrap()
+        .expect_ack(&Command::Configure {
+            param: snapgen_host::protocol::Param::TickDivider,
+            value: 0,
+        })
+        .unwrap();
+    l.host().unwrap().expect_ack(&Command::Reset).unwrap();
+    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
         panic!()
     };
     assert_eq!(st.state, AxisState::Disabled as u8);
     // The reference is tens of counts from the motor: well past a limit of 10.
     assert!((st.position - st.encoder).abs() > 20, "{st:?}");
-    l.command(Command::Configure {
-        param: snapgen_host::protocol::Param::FollowingLimit,
-        value: 10,
-    })
-    .unwrap();
-    l.command(Command::Power { on: true }).unwrap();
+    l.host()
+        .unwrap()
+        .expect_ack(&Command::Configure {
+            param: snapgen_host::protocol::Param::FollowingLimit,
+            value: 10,
+        })
+        .unwrap();
+    l.host()
+        .unwrap()
+        .expect_ack(&Command::Power { on: true })
+        .unwrap();
     l.run(5_000);
-    l.command(Command::Configure {
-        param: snapgen_host::protocol::Param::TickDivider,
-        value: i128::from(d.dividers.tick_div),
-    })
-    .unwrap();
+    l.host()
+        .unwrap()
+        .expect_ack(&Command::Configure {
+            param: snapgen_host::protocol::Param::TickDivider,
+            value: i128::from(d.dividers.tick_div),
+        })
+        .unwrap();
     l.run_until(l.time() + 0.2);
-    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
         panic!()
     };
     assert_eq!(st.state, AxisState::Standstill as u8);
@@ -303,14 +313,16 @@ fn a_new_tick_divider_ticks_on_the_same_clock_in_fabric_and_model() {
     l.run(200);
     l.setup(&s).unwrap();
     for div in [9, 99, 4, 57, 9] {
-        l.command(Command::Configure {
-            param: snapgen_host::protocol::Param::TickDivider,
-            value: div,
-        })
-        .unwrap();
+        l.host()
+            .unwrap()
+            .expect_ack(&Command::Configure {
+                param: snapgen_host::protocol::Param::TickDivider,
+                value: div,
+            })
+            .unwrap();
         l.run(1000);
     }
-    let Reply::Status(st) = l.ask(Command::ReadStatus).unwrap() else {
+    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
         panic!()
     };
     assert!(st.has(flag::SERVO_OVERRUN), "{st:?}");

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use serde::Serialize;
-use snapgen_host::protocol::{Command, Reply};
+
 use snapgen_model::device::Design;
 use snapgen_model::io::servo::ServoConfig;
 use snapgen_model::stop::StopLimits;
@@ -421,10 +421,8 @@ fn run_profile(
             l.run_until(
                 last_start + last_plan.ticks_total() as f64 * f.ts + (last_end - prof.span.end),
             );
-            let landed = match l.ask(Command::ReadState)? {
-                Reply::State(s) => s.x == last_plan.final_state.x && (s.v, s.a, s.j) == (0, 0, 0),
-                _ => false,
-            };
+            let s = l.host().map_err(crate::error::failure)?.state()?;
+            let landed = s.x == last_plan.final_state.x && (s.v, s.a, s.j) == (0, 0, 0);
             let samples = l.take_samples();
             (samples, starts, landed, l.mismatches(), l.clocks())
         }
