@@ -1,5 +1,5 @@
 //! One byte of CRC-16/CCITT-FALSE, combinational: `crc_out` is `crc_in` updated with `data`
-//! (`snapgen_model::protocol::crc16_step`, whose polynomial [`CRC_POLY`] is written into the
+//! (`snapgen_spec::wire::crc16_step`, whose polynomial [`CRC_POLY`] is written into the
 //! Verilog). Written as a Verilog function with a loop, which `#[hdl_gen]` cannot express; the
 //! model's step runs in rust-hdl's simulator. The reply transmitter calls the same function
 //! ([`crc16_function`]).

@@ -1,4 +1,4 @@
-//! Frame receiver (docs/PROTOCOL.md), as `snapgen_model::protocol::Decoder::device()`:
+//! Frame receiver (docs/PROTOCOL.md), as `snapgen_host::protocol::Decoder::device()`:
 //! hunts for the start byte 0xA5, takes a length above 32 as noise (a 0xA5 there starts a new
 //! frame), checks the CRC-16 over length, command, sequence and payload, and pulses `frame` or
 //! `bad_crc` one clock after the last CRC byte. A frame cut short by an inter-byte gap of

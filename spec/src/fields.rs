@@ -199,7 +199,7 @@ payload! {
     /// What a device says about itself (IDENTITY, the reply to PING).
     Identity, IDENTITY_FIELDS {
         protocol: u8 = 1, unsigned, "protocol version ({PROTOCOL_VERSION})";
-        design_hash: u32 = 4, unsigned, "FNV-1a (32 bits) of the design's Verilog generated with this field 0 (docs/HDL.md)";
+        design_hash: u32 = 4, unsigned, "FNV-1a (32 bits) of the design's two files, snapgen_core.v then snapgen_io.v generated with this field 0 (docs/HDL.md)";
         clock_hz: u32 = 4, unsigned, "fabric clock, Hz";
         baud: u32 = 4, unsigned, "the UART's rate: clock / clocks-per-bit, rounded (115 207 for 115 200 at 125 MHz)";
         tick_divider: u32 = 4, unsigned, "clocks per tick − 1, now (Ts = (tick_divider + 1) / clock_hz)";
