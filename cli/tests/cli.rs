@@ -1,19 +1,12 @@
 //! The `snapgen` binary: JSON fields, trace and plot files, and exit codes for bad input.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn snapgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_snapgen"))
-        .args(args)
-        .output()
-        .expect("run snapgen")
-}
+mod common;
+use common::{assert_ok, snapgen};
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("snapgen-cli-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::tmp("cli-test", name)
 }
 
 const ORDER4: &[&str] = &[
@@ -34,11 +27,7 @@ fn plan_json_has_every_field() {
     let mut args = vec!["plan", "--json"];
     args.extend_from_slice(ORDER4);
     let out = snapgen(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for key in [
         "order",
@@ -90,11 +79,7 @@ fn seed001_json_reproduces_table_1() {
         "--phi",
         "0.25",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let t4 = |k: &str| (v[k].as_f64().unwrap() * 1e4).trunc() / 1e4;
     assert_eq!(t4("velocity"), 34.9065);
@@ -126,11 +111,7 @@ fn trace_writes_one_row_per_tick() {
         "--csv",
         csv.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
@@ -152,11 +133,7 @@ fn plot_writes_an_svg() {
     let mut args = vec!["plot", "--svg", svg.to_str().unwrap()];
     args.extend_from_slice(ORDER4);
     let out = snapgen(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg"));
     for label in ["position", "velocity", "acceleration", "jerk", "snap"] {
@@ -429,11 +406,7 @@ fn experiment_json_reports_every_profile() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
     assert!(v["mismatches"].is_null(), "the fast loop has no fabric");
     let profiles = v["profiles"].as_array().unwrap();
@@ -549,11 +522,7 @@ fn online_plays_a_script_and_reports_every_field() {
         "--svg",
         svg.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let outcomes: Vec<&str> = j["commands"]
         .as_array()

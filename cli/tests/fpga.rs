@@ -2,17 +2,14 @@
 //! command; Vivado is not available here, so the build is written, linted and synthesised by
 //! Yosys, not run).
 
+use std::path::PathBuf;
 use std::process::Command;
 
-fn snapgen(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_snapgen"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::{assert_ok, snapgen};
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    std::env::temp_dir().join(format!("snapgen-fpga-{}-{name}", std::process::id()))
+fn tmp(name: &str) -> PathBuf {
+    common::tmp("fpga", name)
 }
 
 #[test]
@@ -25,11 +22,7 @@ fn build_writes_a_complete_vivado_build() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
     let xdc = read("snapgen_zybo_z7_10.xdc");
     assert!(
@@ -101,11 +94,7 @@ fn every_generated_file_reads_together() {
     args.extend_from_slice(&timing);
     let out = snapgen(&args);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(
         text.contains("109 clocks per bit") && text.contains("2000 clocks"),
         "{text}"
@@ -113,11 +102,7 @@ fn every_generated_file_reads_together() {
     let mut args = vec!["build", "--out", dir.to_str().unwrap()];
     args.extend_from_slice(&timing);
     let out = snapgen(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -206,11 +191,7 @@ fn a_board_file_of_ones_own() {
         "--out",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let xdc = std::fs::read_to_string(out_dir.join("snapgen_my_board.xdc")).unwrap();
     assert!(xdc.contains("-period 10.000"), "{xdc}");
     assert!(out_dir.join("snapgen_my_board.v").exists());

@@ -9,6 +9,9 @@ use std::process::Command;
 use snapgen_spec::codes::{COMMANDS, REPLIES};
 use snapgen_spec::emit::{examples, FILE_NAMES};
 
+mod common;
+use common::assert_ok;
+
 fn emit() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("snapgen-spec-test-{}", std::process::id()));
     let out = Command::new(env!("CARGO_BIN_EXE_snapgen"))
@@ -16,11 +19,7 @@ fn emit() -> PathBuf {
         .arg(&dir)
         .output()
         .expect("run snapgen");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     for name in FILE_NAMES {
         assert!(dir.join(name).is_file(), "{name} not written");
     }
@@ -195,11 +194,7 @@ fn update_docs_restores_a_generated_table() {
             .arg(&dir)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_ok(&out);
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
     let first = run();

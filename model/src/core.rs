@@ -18,8 +18,9 @@
 //! * `stop` (a controlled stop, [`crate::stop`]) latches the stop limits and starts the stop
 //!   unit's *Prep* phase (`prep` clocks of [`phase_clocks`], the move plays on); the first tick
 //!   after it takes the stop: a program playing is cut there (busy falls, `aborted` rises;
-//!   `done` is left: a program that ended first did run to its end), then the unit spends `init` clocks computing where its law begins and
-//!   `decide` clocks before every tick choosing that tick's snap (ticks wait for it); when the
+//!   `done` is left: a program that ended first did run to its end), then the unit spends
+//!   `init` clocks computing where its law begins and `decide` clocks before every tick
+//!   choosing that tick's snap (ticks wait for it); when the
 //!   registers are at rest it lets go (`stopping` falls). Requests while a stop runs are
 //!   ignored.
 //! * `abort_move` zeroes v, a and j at once (the emergency stop, with the amplifier off) and
@@ -29,7 +30,8 @@
 //! * `tick_count` counts the ticks since the last start while a program plays or a stop runs;
 //!   `ticks` counts every tick since reset (64 bits).
 //! * `at_rest` is v = a = j = 0; `heading_pos`/`heading_neg` (registered) give the sign of the
-//!   first non-zero of v, a, j: where the axis goes next (a move from rest heads somewhere from its first tick).
+//!   first non-zero of v, a, j: where the axis goes next (a move from rest heads somewhere
+//!   from its first tick).
 //! * Writes go to the standby bank.
 //! * `swap` arms a **program swap** for the tick T = `swap_last + 1` (low 32 bits of the time
 //!   base): the tick that brings `ticks` from `swap_last` to T is still the old program's (or

@@ -53,6 +53,15 @@ fn at(ms: f64, c: MotionCommand) -> Event {
     }
 }
 
+/// A feed-rate override to `k` at `ms`.
+fn feed(ms: f64, k: f64) -> Event {
+    Event {
+        at_ms: ms,
+        at_position: None,
+        action: Action::Override { r#override: k },
+    }
+}
+
 fn play(script: &[Event], order: OnlineOrder) -> RunReport {
     play_on(VirtualBoard::model(&design()), script, order).0
 }
@@ -391,11 +400,6 @@ fn latency_is_tens_of_ms_at_115200_and_a_few_at_3_mbaud() {
 /// such an upload is on the wire waits for it: the bound at 921 600 baud allows for one.
 #[test]
 fn an_override_takes_effect_within_tens_of_ms_at_115200_and_a_few_at_921600() {
-    let feed = |ms: f64, k: f64| Event {
-        at_ms: ms,
-        at_position: None,
-        action: Action::Override { r#override: k },
-    };
     let script = [
         at(0.0, mv(100.0, 200.0, BufferMode::Aborting)),
         feed(40.0, 0.5),
@@ -461,11 +465,6 @@ impl<L: Link> Link for GapLink<L> {
 /// tenths of a second — let a 1 s watchdog expire mid-move: ErrorStop).
 #[test]
 fn the_driver_is_never_silent_longer_than_its_poll_period() {
-    let feed = |ms: f64, k: f64| Event {
-        at_ms: ms,
-        at_position: None,
-        action: Action::Override { r#override: k },
-    };
     let script = [
         at(0.0, mv(100.0, 200.0, BufferMode::Aborting)),
         feed(40.0, 0.5),

@@ -130,66 +130,62 @@ impl Lockstep {
                 (None, Source::Held(i)) => *i,
                 (None, Source::Each(f)) => f(&self.side.model.outputs()),
             };
-            let Some(fab) = self.fabric.as_mut() else {
-                // The model alone.
-                let mut k = 0;
-                loop {
-                    let (m, ticked) = self.side.clock(&inputs);
-                    std::hint::black_box(m);
-                    self.ticks += u64::from(ticked);
-                    self.clock += 1;
-                    k += 1;
-                    if k == cap {
-                        break;
-                    }
-                    if let Source::Each(f) = &mut source {
-                        let next = f(&self.side.model.outputs());
-                        if next != inputs {
-                            self.carry = Some(next);
-                            break;
-                        }
+            let recorded = self.fabric.is_some();
+            let (k, ticked) = self.model_run(&inputs, cap, &mut source, recorded);
+            if let Some(fab) = self.fabric.as_mut() {
+                // The fabric, the same clocks.
+                fab.set(&inputs);
+                fab.run(k, &mut self.got);
+                if let Some(fl) = self.fault {
+                    if fl.clock >= self.clock && fl.clock < self.clock + k as u64 {
+                        let at = (fl.clock - self.clock) as usize * OUT_WORDS;
+                        fl.register.flip(&mut self.got[at..at + OUT_WORDS], fl.bit);
                     }
                 }
-                left -= k as u64;
-                continue;
-            };
-            // The model first, up to the batch or the next change of inputs.
-            self.want.clear();
-            let mut ticked = 0u64;
-            let mut k = 0;
-            loop {
-                let (m, t) = self.side.clock(&inputs);
-                self.want.extend_from_slice(&encode(&m));
-                ticked += u64::from(t);
-                k += 1;
-                if k == cap {
-                    break;
+                if self.got[..k * OUT_WORDS] != self.want[..] {
+                    return Err(self.locate(k));
                 }
-                if let Source::Each(f) = &mut source {
-                    let next = f(&self.side.model.outputs());
-                    if next != inputs {
-                        self.carry = Some(next);
-                        break;
-                    }
-                }
-            }
-            // The fabric, the same clocks.
-            fab.set(&inputs);
-            fab.run(k, &mut self.got);
-            if let Some(fl) = self.fault {
-                if fl.clock >= self.clock && fl.clock < self.clock + k as u64 {
-                    let at = (fl.clock - self.clock) as usize * OUT_WORDS;
-                    fl.register.flip(&mut self.got[at..at + OUT_WORDS], fl.bit);
-                }
-            }
-            if self.got[..k * OUT_WORDS] != self.want[..] {
-                return Err(self.locate(k));
             }
             self.ticks += ticked;
             self.clock += k as u64;
             left -= k as u64;
         }
         Ok(())
+    }
+
+    /// The model's clocks of a batch: with `inputs`, up to `cap` clocks or until the source
+    /// gives other inputs (kept for the next batch); with `record`, each clock's outputs
+    /// encoded into `want`. Returns the clocks run and the ticks among them.
+    #[inline(always)]
+    fn model_run(
+        &mut self,
+        inputs: &CoreInputs,
+        cap: usize,
+        source: &mut Source<'_>,
+        record: bool,
+    ) -> (usize, u64) {
+        self.want.clear();
+        let (mut k, mut ticked) = (0, 0u64);
+        loop {
+            let (m, t) = self.side.clock(inputs);
+            if record {
+                self.want.extend_from_slice(&encode(&m));
+            } else {
+                std::hint::black_box(m);
+            }
+            ticked += u64::from(t);
+            k += 1;
+            if k == cap {
+                return (k, ticked);
+            }
+            if let Source::Each(f) = source {
+                let next = f(&self.side.model.outputs());
+                if next != *inputs {
+                    self.carry = Some(next);
+                    return (k, ticked);
+                }
+            }
+        }
     }
 
     /// The first clock and register of a batch of `k` clocks where the words differ.

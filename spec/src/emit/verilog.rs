@@ -31,6 +31,14 @@ impl LocalParam {
     }
 }
 
+/// The first name that two of `params` share, if any (a Verilog module may not declare a
+/// `localparam` twice).
+pub fn repeated_name(params: &[LocalParam]) -> Option<&str> {
+    let mut names: Vec<&str> = params.iter().map(|q| q.name.as_str()).collect();
+    names.sort_unstable();
+    names.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
+}
+
 /// Every protocol constant: `START_BYTE`, `CMD_*` and `LEN_*` of each command, `RC_*` of
 /// each reply, `R_*` of each reason, `P_*` of each parameter, `S_*` of each axis state and
 /// `E_*` of each error identifier.
@@ -118,11 +126,8 @@ mod tests {
 
     #[test]
     fn names_are_unique() {
-        let a = localparams();
-        let mut names: Vec<&str> = a.iter().map(|q| q.name.as_str()).collect();
-        names.sort_unstable();
-        let n = names.len();
-        names.dedup();
-        assert_eq!(names.len(), n);
+        assert_eq!(repeated_name(&localparams()), None);
+        let twice = [LocalParam::new("A", 1, 0), LocalParam::new("A", 2, 1)];
+        assert_eq!(repeated_name(&twice), Some("A"));
     }
 }
