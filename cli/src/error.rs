@@ -36,6 +36,15 @@ pub fn failure(f: snapgen_host::session::Failure) -> anyhow::Error {
     }
 }
 
+/// A closed loop's error: the host's as [`failure`] sorts it (the user's to fix: exit 2),
+/// the simulation's as it is.
+pub fn loop_failure(e: snapgen_sim::closed_loop::LoopError) -> anyhow::Error {
+    match e {
+        snapgen_sim::closed_loop::LoopError::Host(f) => failure(f),
+        e => e.into(),
+    }
+}
+
 /// The co-simulation found a difference (exit 1; the report is already printed).
 #[derive(Debug, thiserror::Error)]
 #[error("the fabric and the model disagree")]

@@ -13,6 +13,9 @@ use snapgen_host::protocol::{
 use snapgen_model::{Format, DEFAULT_FORMAT};
 use snapgen_plan::{Method, MoveRequest};
 
+mod common;
+use common::assert_ok;
+
 /// The virtual board's Ts (its default design).
 const BOARD_TS: f64 = 1e-4;
 
@@ -120,13 +123,8 @@ fn send(port: &str, extra: &[&str]) -> std::process::Output {
 const S_CURVE: [&str; 7] = ["--order", "3", "--vmax", "0.5", "--amax", "5", "--jmax"];
 
 fn ok(out: &std::process::Output) -> String {
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    text
+    assert_ok(out);
+    String::from_utf8_lossy(&out.stdout).to_string()
 }
 
 #[test]

@@ -313,7 +313,7 @@ fn zero_distance_is_fine() {
         "--dmax",
         "1",
     ]);
-    assert!(out.status.success());
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["ticks_total"], 0);
     assert_eq!(v["segments"], serde_json::json!([]));
@@ -324,11 +324,7 @@ fn demo_runs_and_writes_plots() {
     let dir = tmp("demo");
     let out = snapgen(&["demo", "--out", dir.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(stdout.contains("round trip 0 -> 12π -> 0 ends on the start register bit for bit"));
     assert!(stdout.contains(", 0 mismatches"), "{stdout}");
     assert!(stdout.contains(" 0 latches"), "{stdout}");
@@ -354,11 +350,7 @@ fn cosim_bench_prints_medians_and_the_ratio() {
         "--bench",
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(stdout.contains(", 0 mismatches"), "{stdout}");
     // "... 5 runs: median A, best B M ticks/s ...": positive, best at least the median.
     let numbers = |prefix: &str| -> (f64, f64) {
@@ -449,7 +441,7 @@ fn experiment_json_reports_every_profile() {
 #[test]
 fn gains_prints_configure_values_and_refuses_bad_designs() {
     let out = snapgen(&["gains", "--json"]);
-    assert!(out.status.success());
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let c = &v["configure"];
     for k in [

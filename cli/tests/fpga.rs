@@ -262,11 +262,7 @@ fn unknown_board_is_a_usage_error() {
 fn synth_keeps_the_motion_core_within_budget() {
     let out = snapgen(&["synth", "--board", "zybo-z7-10"]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{text}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     assert!(text.contains("motion core within budget"), "{text}");
     assert!(text.contains("| motion core alone"), "{text}");
     assert!(text.contains("| stop unit"), "{text}");

@@ -10,16 +10,11 @@ use snapgen_spec::codes::{COMMANDS, REPLIES};
 use snapgen_spec::emit::{examples, FILE_NAMES};
 
 mod common;
-use common::assert_ok;
+use common::snapgen_ok;
 
 fn emit() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("snapgen-spec-test-{}", std::process::id()));
-    let out = Command::new(env!("CARGO_BIN_EXE_snapgen"))
-        .args(["spec", "--emit"])
-        .arg(&dir)
-        .output()
-        .expect("run snapgen");
-    assert_ok(&out);
+    snapgen_ok(&["spec", "--emit", dir.to_str().unwrap()]);
     for name in FILE_NAMES {
         assert!(dir.join(name).is_file(), "{name} not written");
     }
@@ -189,12 +184,7 @@ fn update_docs_restores_a_generated_table() {
     let boards = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/BOARDS.md");
     std::fs::copy(&boards, dir.join("BOARDS.md")).unwrap();
     let run = || {
-        let out = Command::new(env!("CARGO_BIN_EXE_snapgen"))
-            .args(["spec", "--update-docs", "--docs"])
-            .arg(&dir)
-            .output()
-            .unwrap();
-        assert_ok(&out);
+        let out = snapgen_ok(&["spec", "--update-docs", "--docs", dir.to_str().unwrap()]);
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
     let first = run();

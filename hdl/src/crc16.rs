@@ -1,8 +1,8 @@
 //! One byte of CRC-16/CCITT-FALSE, combinational: `crc_out` is `crc_in` updated with `data`
 //! (`snapgen_spec::wire::crc16_step`, whose polynomial [`CRC_POLY`] is written into the
-//! Verilog). Written as a Verilog function with a loop, which `#[hdl_gen]` cannot express; the
-//! model's step runs in rust-hdl's simulator. The reply transmitter calls the same function
-//! ([`crc16_function`]).
+//! Verilog). Written as a Verilog function with a loop, which `#[hdl_gen]` cannot express; in
+//! rust-hdl's simulator the block runs `crc16_step` itself. The reply transmitter calls the
+//! same Verilog function ([`crc16_function`]).
 
 use rust_hdl::prelude::*;
 use snapgen_spec::wire::{crc16_step, CRC_POLY};

@@ -17,9 +17,8 @@ use std::f64::consts::PI;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use snapgen_model::device::Design;
-use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
-use snapgen_model::{ChainState, Format, Quantity, DEFAULT_FORMAT};
+use snapgen_model::{ChainState, Format, DEFAULT_FORMAT};
 use snapgen_plan::{plan_from, Method, MoveRequest, Plan};
 use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
@@ -53,10 +52,7 @@ fn setup() -> (Design, Format, AxisSetup, [Plan; 2]) {
         },
     )
     .unwrap();
-    let stop = StopLimits {
-        jerk: (5000.0 * f.scale(Quantity::Jerk)) as i128,
-        accel: (500.0 * f.scale(Quantity::Acceleration)) as i128,
-    };
+    let stop = AxisSetup::stop_limits(&f).unwrap();
     let scurve = |distance, from| {
         plan_from(
             &MoveRequest {

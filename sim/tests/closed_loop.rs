@@ -6,12 +6,11 @@
 use std::f64::consts::PI;
 
 use snapgen_host::protocol::Reason;
-use snapgen_host::protocol::{flag, AxisState, Command, ErrorId, Reply};
+use snapgen_host::protocol::{flag, AxisState, Command, ErrorId, Param};
 use snapgen_host::session::HostError;
 use snapgen_model::device::Design;
-use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
-use snapgen_model::{ChainState, Format, Quantity, DEFAULT_FORMAT};
+use snapgen_model::{ChainState, Format, DEFAULT_FORMAT};
 use snapgen_plan::{plan_from, Method, MoveRequest};
 use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
@@ -29,6 +28,14 @@ fn design() -> Design {
         ts: 50e-6,
     };
     snapgen_hdl::verilog::io_design(&Design::from_timing(&DEFAULT_FORMAT, &t).unwrap())
+}
+
+/// Writes a parameter (acknowledged; no read-back frame, which would move the timing).
+fn write(l: &mut ClosedLoop, param: Param, value: i128) {
+    l.host()
+        .unwrap()
+        .expect_ack(&Command::Configure { param, value })
+        .unwrap();
 }
 
 fn setup(d: &Design, ff: bool) -> (AxisSetup, Format) {
@@ -51,10 +58,7 @@ fn setup(d: &Design, ff: bool) -> (AxisSetup, Format) {
         },
     )
     .unwrap();
-    let stop = StopLimits {
-        jerk: (5000.0 * f.scale(Quantity::Jerk)) as i128,
-        accel: (500.0 * f.scale(Quantity::Acceleration)) as i128,
-    };
+    let stop = AxisSetup::stop_limits(&f).unwrap();
     (
         AxisSetup {
             pwm_period: 100,
@@ -102,9 +106,7 @@ fn moves_on_the_fabric_match_the_model_and_track() {
     for plan in [&out, &back] {
         l.start(&plan.program).unwrap();
         l.run_until(l.starts().last().unwrap() + plan.ticks_total() as f64 * f.ts + 0.3);
-        let Reply::State(st) = l.host().unwrap().request(&Command::ReadState).unwrap() else {
-            panic!()
-        };
+        let st = l.host().unwrap().state().unwrap();
         assert_eq!((st.x, st.v, st.a, st.j), (plan.final_state.x, 0, 0, 0));
     }
     assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
@@ -180,9 +182,7 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     .unwrap();
     l.start(&plan.program).unwrap();
     l.run_until(l.time() + 0.5);
-    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
-        panic!()
-    };
+    let st = l.host().unwrap().status().unwrap();
     assert_eq!(
         (st.state, st.error),
         (AxisState::ErrorStop as u8, ErrorId::FollowingError as u8)
@@ -203,43 +203,21 @@ fn a_following_error_disables_the_amplifier_until_cleared() {
     // tick on every clock the controller's first sample falls on the clock POWER is taken:
     // it must see the loaded reference, not the one the motor coasted away from (which is
     // past the following limit and would trip the fault again at once).
-    l.host()
-        .unwrap()
-        .expect_ack(&Command::Configure {
-            param: snapgen_host::protocol::Param::TickDivider,
-            value: 0,
-        })
-        .unwrap();
+    write(&mut l, Param::TickDivider, 0);
     l.host().unwrap().expect_ack(&Command::Reset).unwrap();
-    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
-        panic!()
-    };
+    let st = l.host().unwrap().status().unwrap();
     assert_eq!(st.state, AxisState::Disabled as u8);
     // The reference is tens of counts from the motor: well past a limit of 10.
     assert!((st.position - st.encoder).abs() > 20, "{st:?}");
-    l.host()
-        .unwrap()
-        .expect_ack(&Command::Configure {
-            param: snapgen_host::protocol::Param::FollowingLimit,
-            value: 10,
-        })
-        .unwrap();
+    write(&mut l, Param::FollowingLimit, 10);
     l.host()
         .unwrap()
         .expect_ack(&Command::Power { on: true })
         .unwrap();
     l.run(5_000);
-    l.host()
-        .unwrap()
-        .expect_ack(&Command::Configure {
-            param: snapgen_host::protocol::Param::TickDivider,
-            value: i128::from(d.dividers.tick_div),
-        })
-        .unwrap();
+    write(&mut l, Param::TickDivider, i128::from(d.dividers.tick_div));
     l.run_until(l.time() + 0.2);
-    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
-        panic!()
-    };
+    let st = l.host().unwrap().status().unwrap();
     assert_eq!(st.state, AxisState::Standstill as u8);
     assert!((st.position - st.encoder).abs() <= 1, "{st:?}");
     assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
@@ -313,18 +291,10 @@ fn a_new_tick_divider_ticks_on_the_same_clock_in_fabric_and_model() {
     l.run(200);
     l.setup(&s).unwrap();
     for div in [9, 99, 4, 57, 9] {
-        l.host()
-            .unwrap()
-            .expect_ack(&Command::Configure {
-                param: snapgen_host::protocol::Param::TickDivider,
-                value: div,
-            })
-            .unwrap();
+        write(&mut l, Param::TickDivider, div);
         l.run(1000);
     }
-    let Reply::Status(st) = l.host().unwrap().request(&Command::ReadStatus).unwrap() else {
-        panic!()
-    };
+    let st = l.host().unwrap().status().unwrap();
     assert!(st.has(flag::SERVO_OVERRUN), "{st:?}");
     assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
 }

@@ -17,9 +17,8 @@ use serde::Serialize;
 
 use snapgen_model::device::Design;
 use snapgen_model::io::servo::ServoConfig;
-use snapgen_model::stop::StopLimits;
 use snapgen_model::timing::Timing;
-use snapgen_model::{Format, Quantity, DEFAULT_FORMAT};
+use snapgen_model::{Format, DEFAULT_FORMAT};
 use snapgen_plant::fast::{FabricTiming, FastLoop, LoopSample};
 use snapgen_plant::gains::{derive, Gains, LoopDesign, LoopTiming};
 use snapgen_plant::metrics::{figures, MoveFigures, MoveSpan};
@@ -400,19 +399,17 @@ fn run_profile(
             let mut l =
                 ClosedLoop::new(design, p, o.step_s, o.board == Board::Fabric, record_every)?;
             l.run(1000);
-            let stop = StopLimits {
-                jerk: (5000.0 * f.scale(Quantity::Jerk)) as i128,
-                accel: (500.0 * f.scale(Quantity::Acceleration)) as i128,
-            };
+            let stop = AxisSetup::stop_limits(f).map_err(InputError::Host)?;
             l.setup(&AxisSetup {
                 pwm_period,
                 servo: *servo,
                 stop,
-            })?;
+            })
+            .map_err(crate::error::loop_failure)?;
             let origin = l.time();
             for (t, plan) in &prof.moves {
                 l.run_until(origin + t);
-                l.start(&plan.program)?;
+                l.start(&plan.program).map_err(crate::error::loop_failure)?;
             }
             let starts = l.starts();
             // The watch after the last move, from its real start.

@@ -2,8 +2,8 @@
 //!
 //! Each batch runs the model first: clock by clock, with the inputs a source gives for each
 //! clock from the model's outputs before it (a constant, or a board's executor clocked
-//! beside the core), encoding every clock's outputs in the harness's word layout, until the
-//! inputs change or the batch is full. The fabric then runs the same clocks with those inputs
+//! beside the core), encoding every clock's outputs in the harness's word layout (not when the
+//! model runs alone, the benchmark's reference), until the inputs change or the batch is full. The fabric then runs the same clocks with those inputs
 //! (one call into the Verilated library) and its words are compared with the model's in one
 //! slice comparison; only a difference is looked at register by register. A fault (tests)
 //! flips a bit of the fabric's words at its clock.

@@ -31,7 +31,7 @@ impl LocalParam {
     }
 }
 
-/// The first name that two of `params` share, if any (a Verilog module may not declare a
+/// A name that two of `params` share, if any (the first such in alphabetical order) (a Verilog module may not declare a
 /// `localparam` twice).
 pub fn repeated_name(params: &[LocalParam]) -> Option<&str> {
     let mut names: Vec<&str> = params.iter().map(|q| q.name.as_str()).collect();
