@@ -26,8 +26,13 @@
 //!   values at the piece ends, all evaluated exactly.
 //!
 //! The tests compare this with a plain tick-by-tick loop on small programs.
+//!
+//! [`path`] holds a multi-axis trace against the path it was programmed to follow (lines, arcs,
+//! helices) and each axis's limits, from the integer positions alone.
 
 use ethnum::I256;
+
+pub mod path;
 
 /// The four registers of the chain, exact.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

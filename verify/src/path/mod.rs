@@ -1,0 +1,406 @@
+//! An independent check of a multi-axis path: does a per-tick trace of N axes stay on the
+//! programmed path, and within each axis's limits?
+//!
+//! For the coordinated motion of several axes along lines, arcs and helices (seed 002's
+//! Cartesian path following). Like the rest of this crate it uses nothing a planner or an
+//! interpolator computes: it takes the path as the user programmed it (end points, centres,
+//! directions on the integer grid) and the integer positions the axes took, tick by tick.
+//!
+//! * **Geometry** ([`follow`]): every point of the trace must lie on the path within a bound,
+//!   the elements visited in their order (a point may lie on an element after the current one,
+//!   never before it), and the trace must end exactly on the last element's end point. A
+//!   line's bound is per axis ([`line`]: a point of the exact segment exists from which every
+//!   axis is within `b`), an arc's is radial in its plane and per axis off it ([`arc`]).
+//!   Lines and the radial and angular tests of arcs are exact (integer arithmetic of any
+//!   size); only a helix's axial test uses floating point, with its rounding error counted
+//!   against the trace (it may refuse a point within the bound by a hair, never accept one
+//!   beyond it).
+//! * **Limits** ([`limits`]): each axis's velocity, acceleration and jerk, as the first, second
+//!   and third differences of its positions from tick to tick, and the path's speed (the
+//!   Euclidean length of a tick's step), never above their limits.
+//!
+//! Units are the caller's integers: positions and bounds on one grid shared by all the axes
+//! (a group's axes interpolate in one frame), limits in that grid's units per tick, tick², tick³.
+
+pub mod arc;
+pub mod limits;
+pub mod line;
+
+use num_bigint::BigInt;
+
+pub use arc::{Arc, Direction};
+pub use line::Line;
+
+/// One element of a path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Element {
+    /// A straight line.
+    Line(Line),
+    /// A circular arc in a plane of two axes, or a helix (the other axes move linearly with
+    /// the angle).
+    Arc(Arc),
+}
+
+impl Element {
+    /// Its start point.
+    pub fn from(&self) -> &[i128] {
+        match self {
+            Element::Line(l) => &l.from,
+            Element::Arc(a) => &a.from,
+        }
+    }
+
+    /// Its end point.
+    pub fn to(&self) -> &[i128] {
+        match self {
+            Element::Line(l) => &l.to,
+            Element::Arc(a) => &a.to,
+        }
+    }
+
+    /// True when `p` lies on the element within `bound`.
+    pub fn holds(&self, p: &[i128], bound: i128) -> bool {
+        match self {
+            Element::Line(l) => l.holds(p, bound),
+            Element::Arc(a) => a.holds(p, bound),
+        }
+    }
+}
+
+/// What is wrong with a path or a trace.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PathError {
+    /// The path has no element.
+    #[error("the path has no element")]
+    Empty,
+    /// An element with another number of axes than the path's first.
+    #[error("element {element} has {found} axes, the path {axes}")]
+    Axes {
+        /// The element.
+        element: usize,
+        /// The path's axes.
+        axes: usize,
+        /// Found.
+        found: usize,
+    },
+    /// A trace point with another number of axes than the path.
+    #[error("the trace's tick {tick} has {found} axes, the path {axes}")]
+    TraceAxes {
+        /// The tick.
+        tick: usize,
+        /// The path's axes.
+        axes: usize,
+        /// Found.
+        found: usize,
+    },
+    /// An element that does not begin where the one before it ends.
+    #[error("element {element} begins at {from:?}, not where element {} ends ({prev_to:?})", element - 1)]
+    Gap {
+        /// The element.
+        element: usize,
+        /// Where it begins.
+        from: Vec<i128>,
+        /// Where the one before ends.
+        prev_to: Vec<i128>,
+    },
+    /// An element that cannot be followed as given (see the message).
+    #[error("element {element}: {why}")]
+    Element {
+        /// The element.
+        element: usize,
+        /// Why.
+        why: String,
+    },
+}
+
+/// Where a trace left its path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Deviation {
+    /// The point of `tick` lies on no element from the current one on.
+    OffPath {
+        /// The tick.
+        tick: usize,
+        /// The element it was on before.
+        element: usize,
+        /// Its point.
+        point: Vec<i128>,
+    },
+    /// The trace does not end on the path's end point.
+    End {
+        /// Its last point.
+        point: Vec<i128>,
+        /// The path's end point.
+        end: Vec<i128>,
+    },
+}
+
+/// What [`follow`] found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Followed {
+    /// For each element, the first tick whose point lay on it (None: passed within a tick).
+    pub entered: Vec<Option<usize>>,
+}
+
+/// Checks a path before a trace is held against it: at least one element, one number of axes,
+/// each element beginning where the one before it ends, each element well formed.
+pub fn check_path(path: &[Element]) -> Result<usize, PathError> {
+    let first = path.first().ok_or(PathError::Empty)?;
+    let axes = first.from().len();
+    for (k, e) in path.iter().enumerate() {
+        for found in [e.from().len(), e.to().len()] {
+            if found != axes {
+                return Err(PathError::Axes {
+                    element: k,
+                    axes,
+                    found,
+                });
+            }
+        }
+        if k > 0 && path[k - 1].to() != e.from() {
+            return Err(PathError::Gap {
+                element: k,
+                from: e.from().to_vec(),
+                prev_to: path[k - 1].to().to_vec(),
+            });
+        }
+        if let Element::Arc(a) = e {
+            a.check(axes)
+                .map_err(|why| PathError::Element { element: k, why })?;
+        }
+    }
+    Ok(axes)
+}
+
+/// Holds `trace` (one point per tick, from the first tick of the path) against `path`: every
+/// point within `bound` of an element, the elements in their order, the last point exactly
+/// the path's end (see the module documentation). `Err(PathError)` for a path or trace that
+/// cannot be checked; `Ok(Err(Deviation))` for a trace that leaves the path.
+#[allow(clippy::type_complexity)]
+pub fn follow(
+    path: &[Element],
+    trace: &[Vec<i128>],
+    bound: i128,
+) -> Result<Result<Followed, Deviation>, PathError> {
+    let axes = check_path(path)?;
+    if let Some((tick, p)) = trace.iter().enumerate().find(|(_, p)| p.len() != axes) {
+        return Err(PathError::TraceAxes {
+            tick,
+            axes,
+            found: p.len(),
+        });
+    }
+    let mut entered = vec![None; path.len()];
+    let mut at = 0;
+    for (tick, p) in trace.iter().enumerate() {
+        if path[at].holds(p, bound) {
+            entered[at].get_or_insert(tick);
+            continue;
+        }
+        match (at + 1..path.len()).find(|&k| path[k].holds(p, bound)) {
+            Some(k) => {
+                at = k;
+                entered[k] = Some(tick);
+            }
+            None => {
+                return Ok(Err(Deviation::OffPath {
+                    tick,
+                    element: at,
+                    point: p.clone(),
+                }))
+            }
+        }
+    }
+    let end = path[path.len() - 1].to();
+    match trace.last() {
+        Some(p) if p.as_slice() == end => Ok(Ok(Followed { entered })),
+        last => Ok(Err(Deviation::End {
+            point: last.cloned().unwrap_or_default(),
+            end: end.to_vec(),
+        })),
+    }
+}
+
+/// `x` as an exact integer.
+pub(crate) fn big(x: i128) -> BigInt {
+    BigInt::from(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A slot: a line from (0, 0) to (1000, 0), a half turn counter-clockwise around
+    /// (1000, 500) to (1000, 1000), a line back to (0, 1000); with z climbing 300 on the arc.
+    fn slot() -> Vec<Element> {
+        vec![
+            Element::Line(Line {
+                from: vec![0, 0, 0],
+                to: vec![1000, 0, 0],
+            }),
+            Element::Arc(Arc {
+                plane: [0, 1],
+                centre: [1000, 500],
+                direction: Direction::CounterClockwise,
+                from: vec![1000, 0, 0],
+                to: vec![1000, 1000, 300],
+            }),
+            Element::Line(Line {
+                from: vec![1000, 1000, 300],
+                to: vec![0, 1000, 300],
+            }),
+        ]
+    }
+
+    /// The slot sampled in `n` steps per element, rounded to the grid (a generator of its own:
+    /// floating point, not this module's arithmetic).
+    fn sampled(n: usize) -> Vec<Vec<i128>> {
+        let mut out = Vec::new();
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            out.push(vec![(1000.0 * t).round() as i128, 0, 0]);
+        }
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            let th = -std::f64::consts::FRAC_PI_2 + t * std::f64::consts::PI;
+            out.push(vec![
+                (1000.0 + 500.0 * th.cos()).round() as i128,
+                (500.0 + 500.0 * th.sin()).round() as i128,
+                (300.0 * t).round() as i128,
+            ]);
+        }
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            out.push(vec![(1000.0 * (1.0 - t)).round() as i128, 1000, 300]);
+        }
+        out
+    }
+
+    #[test]
+    fn a_rounded_slot_is_followed_and_each_change_of_it_is_caught() {
+        let path = slot();
+        let trace = sampled(97);
+        let f = follow(&path, &trace, 1).unwrap().unwrap();
+        assert_eq!(f.entered, vec![Some(0), Some(98), Some(195)]);
+        // One point moved off the path by 2 or more across it (along a line it would stay on
+        // the path): off the path there. On the arc: 3 out or in along its radius, or 2 up.
+        let across = |p: &[i128], k: usize| -> Vec<i128> {
+            let (dx, dy) = ((p[0] - 1000) as f64, (p[1] - 500) as f64);
+            let n = dx.hypot(dy);
+            let s = if k == 0 { 3.0 } else { -3.0 };
+            vec![
+                p[0] + (s * dx / n).round() as i128,
+                p[1] + (s * dy / n).round() as i128,
+                p[2],
+            ]
+        };
+        for tick in [5, 120, 150, 250] {
+            let on_arc = (98..195).contains(&tick);
+            for k in 0..3 {
+                let mut bad = trace.clone();
+                match (on_arc, k) {
+                    (true, 2) | (false, 0) => bad[tick][2] += 2,
+                    (true, _) => bad[tick] = across(&trace[tick], k),
+                    (false, _) => bad[tick][1] += if k == 1 { 2 } else { -2 },
+                }
+                match follow(&path, &bad, 1).unwrap() {
+                    Err(Deviation::OffPath { tick: t, .. }) => assert_eq!(t, tick),
+                    r => panic!("tick {tick} change {k}: {r:?}"),
+                }
+            }
+        }
+        // Back onto an element already left.
+        let mut back = trace.clone();
+        back[200] = trace[50].clone();
+        assert!(matches!(
+            follow(&path, &back, 1).unwrap(),
+            Err(Deviation::OffPath { tick: 200, .. })
+        ));
+        // Ending a count short of the end point.
+        let mut short = trace.clone();
+        short.last_mut().unwrap()[0] = 1;
+        assert!(matches!(
+            follow(&path, &short, 1).unwrap(),
+            Err(Deviation::End { .. })
+        ));
+        // A trace that skips the arc's first half within one tick is still on the path.
+        let mut skip = trace.clone();
+        skip.drain(99..140);
+        assert!(follow(&path, &skip, 1).unwrap().is_ok());
+    }
+
+    #[test]
+    fn paths_that_cannot_be_checked_say_why() {
+        assert_eq!(follow(&[], &[], 1), Err(PathError::Empty));
+        let mut gap = slot();
+        if let Element::Line(l) = &mut gap[2] {
+            l.from = vec![1000, 1001, 300];
+        }
+        assert!(matches!(
+            check_path(&gap),
+            Err(PathError::Gap { element: 2, .. })
+        ));
+        let mut flat = slot();
+        if let Element::Arc(a) = &mut flat[1] {
+            a.plane = [0, 3];
+        }
+        let e = check_path(&flat).unwrap_err();
+        assert!(
+            e.to_string().starts_with("element 1: the plane's axes"),
+            "{e}"
+        );
+        let two_axes = vec![vec![0, 0]];
+        assert_eq!(
+            follow(&slot(), &two_axes, 1),
+            Err(PathError::TraceAxes {
+                tick: 0,
+                axes: 3,
+                found: 2
+            })
+        );
+    }
+
+    proptest! {
+        /// Any point of a random line, rounded to the grid, lies within 1 of it on every axis
+        /// (rounding moves each by at most ½); any point of a random arc within 2 of it (the
+        /// arc's own rounded start sets its radius). The arcs here are flat: a helix's axial
+        /// test is checked on exact cases above.
+        #[test]
+        fn rounded_points_lie_within_one(
+            a in prop::array::uniform3(-1_000_000i64..1_000_000),
+            b in prop::array::uniform3(-1_000_000i64..1_000_000),
+            r in 50i64..1_000_000,
+            start in 0.0f64..std::f64::consts::TAU,
+            sweep in 0.01f64..std::f64::consts::TAU,
+            ccw in any::<bool>(),
+            t in 0.0f64..=1.0,
+        ) {
+            let line = Line {
+                from: a.map(i128::from).to_vec(),
+                to: b.map(i128::from).to_vec(),
+            };
+            let p: Vec<i128> = (0..3)
+                .map(|i| (a[i] as f64 + t * (b[i] - a[i]) as f64).round() as i128)
+                .collect();
+            prop_assert!(line.holds(&p, 1), "{:?} {:?}", line, p);
+            let sign = if ccw { 1.0 } else { -1.0 };
+            let at = |u: f64| {
+                let th = start + sign * u * sweep;
+                let x = a[0] as f64 + r as f64 * th.cos();
+                let y = a[1] as f64 + r as f64 * th.sin();
+                vec![x.round() as i128, y.round() as i128, i128::from(a[2])]
+            };
+            let arc = Arc {
+                plane: [0, 1],
+                centre: [i128::from(a[0]), i128::from(a[1])],
+                direction: if ccw { Direction::CounterClockwise } else { Direction::Clockwise },
+                from: at(0.0),
+                to: at(1.0),
+            };
+            // The rounded start sets the radius: the exact circle lies within √½ of the
+            // float one, the rounded point within √½ of that: within 2.
+            prop_assume!(arc.check(3).is_ok());
+            prop_assert!(arc.holds(&at(t), 2), "{:?} {:?}", arc, at(t));
+        }
+    }
+}
