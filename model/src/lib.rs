@@ -22,6 +22,7 @@ pub mod device;
 pub mod error;
 pub mod format;
 pub mod io;
+pub mod path;
 pub mod peaks;
 pub mod peer;
 pub mod ports;
