@@ -11,6 +11,7 @@
 
 pub mod error;
 pub mod online;
+pub mod path;
 pub mod planner;
 
 pub use error::PlanError;

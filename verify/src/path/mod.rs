@@ -29,6 +29,7 @@ pub mod line;
 use num_bigint::BigInt;
 
 pub use arc::{Arc, Direction};
+pub use limits::{AxisLimits, Exceeded, Peaks};
 pub use line::Line;
 
 /// One element of a path.
@@ -58,12 +59,29 @@ impl Element {
         }
     }
 
-    /// True when `p` lies on the element within `bound`.
-    pub fn holds(&self, p: &[i128], bound: i128) -> bool {
+    /// True when `p` lies on the element within its kind's bound.
+    pub fn holds(&self, p: &[i128], bounds: Bounds) -> bool {
         match self {
-            Element::Line(l) => l.holds(p, bound),
-            Element::Arc(a) => a.holds(p, bound),
+            Element::Line(l) => l.holds(p, bounds.line),
+            Element::Arc(a) => a.holds(p, bounds.arc),
         }
+    }
+}
+
+/// How far a point may lie from each kind of element (issue 22 asks 1 LSB of a line on
+/// every axis, 2 of an arc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bounds {
+    /// From a line, on every axis.
+    pub line: i128,
+    /// From an arc: radially in its plane, and on each other axis.
+    pub arc: i128,
+}
+
+impl Bounds {
+    /// The same bound for every kind.
+    pub const fn all(b: i128) -> Self {
+        Bounds { line: b, arc: b }
     }
 }
 
@@ -172,14 +190,14 @@ pub fn check_path(path: &[Element]) -> Result<usize, PathError> {
 }
 
 /// Holds `trace` (one point per tick, from the first tick of the path) against `path`: every
-/// point within `bound` of an element, the elements in their order, the last point exactly
+/// point within `bounds` of an element, the elements in their order, the last point exactly
 /// the path's end (see the module documentation). `Err(PathError)` for a path or trace that
 /// cannot be checked; `Ok(Err(Deviation))` for a trace that leaves the path.
 #[allow(clippy::type_complexity)]
 pub fn follow(
     path: &[Element],
     trace: &[Vec<i128>],
-    bound: i128,
+    bounds: Bounds,
 ) -> Result<Result<Followed, Deviation>, PathError> {
     let axes = check_path(path)?;
     if let Some((tick, p)) = trace.iter().enumerate().find(|(_, p)| p.len() != axes) {
@@ -192,11 +210,11 @@ pub fn follow(
     let mut entered = vec![None; path.len()];
     let mut at = 0;
     for (tick, p) in trace.iter().enumerate() {
-        if path[at].holds(p, bound) {
+        if path[at].holds(p, bounds) {
             entered[at].get_or_insert(tick);
             continue;
         }
-        match (at + 1..path.len()).find(|&k| path[k].holds(p, bound)) {
+        match (at + 1..path.len()).find(|&k| path[k].holds(p, bounds)) {
             Some(k) => {
                 at = k;
                 entered[k] = Some(tick);
@@ -280,7 +298,7 @@ mod tests {
     fn a_rounded_slot_is_followed_and_each_change_of_it_is_caught() {
         let path = slot();
         let trace = sampled(97);
-        let f = follow(&path, &trace, 1).unwrap().unwrap();
+        let f = follow(&path, &trace, Bounds::all(1)).unwrap().unwrap();
         assert_eq!(f.entered, vec![Some(0), Some(98), Some(195)]);
         // One point moved off the path by 2 or more across it (along a line it would stay on
         // the path): off the path there. On the arc: 3 out or in along its radius, or 2 up.
@@ -303,7 +321,7 @@ mod tests {
                     (true, _) => bad[tick] = across(&trace[tick], k),
                     (false, _) => bad[tick][1] += if k == 1 { 2 } else { -2 },
                 }
-                match follow(&path, &bad, 1).unwrap() {
+                match follow(&path, &bad, Bounds::all(1)).unwrap() {
                     Err(Deviation::OffPath { tick: t, .. }) => assert_eq!(t, tick),
                     r => panic!("tick {tick} change {k}: {r:?}"),
                 }
@@ -313,25 +331,25 @@ mod tests {
         let mut back = trace.clone();
         back[200] = trace[50].clone();
         assert!(matches!(
-            follow(&path, &back, 1).unwrap(),
+            follow(&path, &back, Bounds::all(1)).unwrap(),
             Err(Deviation::OffPath { tick: 200, .. })
         ));
         // Ending a count short of the end point.
         let mut short = trace.clone();
         short.last_mut().unwrap()[0] = 1;
         assert!(matches!(
-            follow(&path, &short, 1).unwrap(),
+            follow(&path, &short, Bounds::all(1)).unwrap(),
             Err(Deviation::End { .. })
         ));
         // A trace that skips the arc's first half within one tick is still on the path.
         let mut skip = trace.clone();
         skip.drain(99..140);
-        assert!(follow(&path, &skip, 1).unwrap().is_ok());
+        assert!(follow(&path, &skip, Bounds::all(1)).unwrap().is_ok());
     }
 
     #[test]
     fn paths_that_cannot_be_checked_say_why() {
-        assert_eq!(follow(&[], &[], 1), Err(PathError::Empty));
+        assert_eq!(follow(&[], &[], Bounds::all(1)), Err(PathError::Empty));
         let mut gap = slot();
         if let Element::Line(l) = &mut gap[2] {
             l.from = vec![1000, 1001, 300];
@@ -351,7 +369,7 @@ mod tests {
         );
         let two_axes = vec![vec![0, 0]];
         assert_eq!(
-            follow(&slot(), &two_axes, 1),
+            follow(&slot(), &two_axes, Bounds::all(1)),
             Err(PathError::TraceAxes {
                 tick: 0,
                 axes: 3,

@@ -1,0 +1,159 @@
+//! Several axes along one path (issue 22, first part): a path of a line, a helical half turn
+//! and a line (tangent in space), planned on its length alone by the rest-to-rest planner, played tick by tick on
+//! the chain and mapped onto the axes by the interpolator's integer rules
+//! (`snapgen_model::path::interp`); then held, from the axes' positions alone, against the path
+//! as programmed (`snapgen_verify::path`: lines within 1 LSB on every axis, the arc within 2,
+//! ending exactly on the end point) and against each axis's limits.
+//!
+//! The limits each axis sees are the path's plus what its geometry adds: on the arc the
+//! centripetal acceleration `v²/R`, and where the line meets the arc that acceleration's step
+//! within one tick, a jerk of `v²/(R·Ts)`. The bounds below are that physics, computed from
+//! the path's limits and the radius, not from the interpolator. Keeping them within an axis's
+//! own limits is the motion planner's job (the speed an element allows), not built yet.
+
+use snapgen_model::chain::Trace;
+use snapgen_model::{Format, Quantity, DEFAULT_FORMAT, FRAC_BITS};
+use snapgen_plan::path::{prepare, Element};
+use snapgen_plan::{plan, Method, MoveRequest};
+use snapgen_verify::path::limits::{check, AxisLimits};
+use snapgen_verify::path::{follow, Arc, Bounds, Direction, Element as Checked, Line};
+
+/// mm: 1 nm LSB, Ts = 100 µs.
+const F: Format = Format {
+    ts: 1e-4,
+    ..DEFAULT_FORMAT
+};
+const MM: i64 = 1_000_000;
+const V: f64 = 20.0;
+const A: f64 = 500.0;
+const J: f64 = 100_000.0;
+const R: f64 = 20.0;
+
+/// A slot in XY climbing in z at one slope, 1 in 10, all along (so that the helix meets the
+/// lines tangentially in space: a flat line met by a climbing helix is a corner, which the
+/// per-axis check below finds at once, a jerk 25 times the bound): a line 30 mm along x, a
+/// helical half turn of radius 20 mm, a line 30 mm back.
+fn points() -> [Vec<i64>; 4] {
+    let climb = |mm: f64| (mm * 0.1 * MM as f64).round() as i64;
+    let arc = std::f64::consts::PI * R;
+    [
+        vec![0, 0, 0],
+        vec![30 * MM, 0, climb(30.0)],
+        vec![30 * MM, 40 * MM, climb(30.0 + arc)],
+        vec![0, 40 * MM, climb(60.0 + arc)],
+    ]
+}
+
+fn grid(p: &[i64]) -> Vec<i128> {
+    p.iter().map(|&x| i128::from(x)).collect()
+}
+
+/// The raw positions of every axis on every tick, from rest to rest.
+fn played() -> Vec<Vec<i128>> {
+    let [start, a, b, c] = points();
+    let prepared = prepare(
+        &start,
+        &[
+            Element::Line { to: a },
+            Element::Arc {
+                plane: [0, 1],
+                centre: [30 * MM, 20 * MM],
+                ccw: true,
+                to: b,
+            },
+            Element::Line { to: c },
+        ],
+    )
+    .unwrap();
+    let p = plan(
+        &MoveRequest {
+            distance: prepared.length_physical(F.position_lsb),
+            method: Method::Order3 {
+                vmax: V,
+                amax: A,
+                jmax: J,
+            },
+        },
+        &F,
+    )
+    .unwrap();
+    // The path fitted onto the chain's exact displacement (the planner's quantized move of
+    // the path's length: within an LSB of it).
+    let moved = p.final_state.x - p.start.x;
+    assert!((moved - prepared.length()).abs() < 1 << FRAC_BITS);
+    let path = prepared.fit(moved).unwrap();
+    Trace::new(&p.program, p.start, F.widths)
+        .map(|t| path.at(t.state.x - p.start.x).unwrap())
+        .collect()
+}
+
+#[test]
+fn a_helical_slot_stays_on_its_path_and_ends_on_its_point() {
+    let raw = played();
+    let on_grid: Vec<Vec<i128>> = raw
+        .iter()
+        .map(|p| p.iter().map(|x| x >> FRAC_BITS).collect())
+        .collect();
+    let [start, a, b, c] = points();
+    let path = [
+        Checked::Line(Line {
+            from: grid(&start),
+            to: grid(&a),
+        }),
+        Checked::Arc(Arc {
+            plane: [0, 1],
+            centre: [30 * i128::from(MM), 20 * i128::from(MM)],
+            direction: Direction::CounterClockwise,
+            from: grid(&a),
+            to: grid(&b),
+        }),
+        Checked::Line(Line {
+            from: grid(&b),
+            to: grid(&c),
+        }),
+    ];
+    let followed = follow(&path, &on_grid, Bounds { line: 1, arc: 2 })
+        .unwrap()
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(followed.entered.iter().all(Option::is_some));
+    // The check is not blind: one axis of one tick on the arc two LSBs out fails it.
+    let mut bad = on_grid.clone();
+    let k = followed.entered[1].unwrap() + 100;
+    bad[k][2] += 3;
+    assert!(follow(&path, &bad, Bounds { line: 1, arc: 2 })
+        .unwrap()
+        .is_err());
+}
+
+#[test]
+fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
+    let raw = played();
+    let s = |q| F.scale(q);
+    let slack = 1.0 + 1e-6;
+    let limits = AxisLimits {
+        velocity: (V * s(Quantity::Velocity) * slack) as i128,
+        acceleration: ((A + V * V / R) * s(Quantity::Acceleration) * slack) as i128,
+        jerk: ((J + V * V / (R * F.ts) + V.powi(3) / (R * R) + 3.0 * V * A / R)
+            * s(Quantity::Jerk)
+            * slack) as i128,
+    };
+    let speed = (V * s(Quantity::Velocity) * slack) as i128;
+    let peaks = check(&raw, &[limits; 3], Some(speed)).unwrap_or_else(|e| panic!("{e:?}"));
+    // The term the arc adds is there, where the line meets it: y stands still along the
+    // first line, then takes the centripetal acceleration within a tick or two, a jerk of the
+    // order of v²/(R·Ts) (in the plane the speed is v/√1.01).
+    let y: Vec<f64> = raw.iter().map(|p| p[1] as f64).collect();
+    let meets = y.iter().position(|&q| q != y[0]).expect("y moves");
+    let jerk_y = (meets.saturating_sub(3)..meets + 3)
+        .map(|k| (y[k + 3] - 3.0 * y[k + 2] + 3.0 * y[k + 1] - y[k]).abs())
+        .fold(0.0, f64::max)
+        / s(Quantity::Jerk);
+    let jump = V * V / 1.01 / (R * F.ts);
+    assert!(
+        jerk_y > 0.25 * jump && jerk_y <= jump * slack,
+        "{jerk_y} against {jump}"
+    );
+    let jerk = |i: usize| peaks.axes[i][2].as_f64() / s(Quantity::Jerk);
+    // z climbs at a constant share of the path speed (1 in √101): within the path's.
+    assert!(jerk(2) <= J / 101f64.sqrt() * 1.001, "{}", jerk(2));
+}
