@@ -81,7 +81,7 @@ fn played() -> Vec<Vec<i128>> {
     // the path's length: within an LSB of it).
     let moved = p.final_state.x - p.start.x;
     assert!((moved - prepared.length()).abs() < 1 << FRAC_BITS);
-    let path = prepared.fit(moved).unwrap();
+    let path = prepared.fit(moved);
     Trace::new(&p.program, p.start, F.widths)
         .map(|t| path.at(t.state.x - p.start.x).unwrap())
         .collect()
@@ -156,4 +156,159 @@ fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
     let jerk = |i: usize| peaks.axes[i][2].as_f64() / s(Quantity::Jerk);
     // z climbs at a constant share of the path speed (1 in √101): within the path's.
     assert!(jerk(2) <= J / 101f64.sqrt() * 1.001, "{}", jerk(2));
+}
+
+mod elements {
+    //! Any single element, any axis limits: planned on its length with the limits the element
+    //! allows (`snapgen_plan::path::speed`), every axis stays within its own limits on every
+    //! tick (from the positions' differences, exactly) and on the element.
+
+    use super::*;
+    use proptest::prelude::*;
+    use snapgen_plan::path::speed::{element_limits, Limits};
+
+    fn axis() -> impl Strategy<Value = Limits> {
+        (5.0f64..100.0, 50.0f64..2000.0, 1e3f64..1e6).prop_map(|(v, a, j)| Limits {
+            velocity: v,
+            acceleration: a,
+            jerk: j,
+        })
+    }
+
+    /// Raw per-axis limits of `axes` in `F`.
+    fn raw_limits(axes: &[Limits]) -> Vec<AxisLimits> {
+        let s = |q| F.scale(q);
+        axes.iter()
+            .map(|a| AxisLimits {
+                velocity: (a.velocity * s(Quantity::Velocity)) as i128,
+                acceleration: (a.acceleration * s(Quantity::Acceleration)) as i128,
+                jerk: (a.jerk * s(Quantity::Jerk)) as i128,
+            })
+            .collect()
+    }
+
+    /// The check is not blind: a small arc planned with the axes' own limits, as if it were a
+    /// line (no centripetal share), goes past an axis's acceleration; with the limits the
+    /// element allows it does not.
+    #[test]
+    fn a_small_arc_at_the_axes_own_limits_is_caught() {
+        let axes = [Limits {
+            velocity: 100.0,
+            acceleration: 1000.0,
+            jerk: 100_000.0,
+        }; 2];
+        let arc = Element::Arc {
+            plane: [0, 1],
+            centre: [0, MM / 2],
+            ccw: true,
+            to: vec![0, MM],
+        };
+        let prepared = prepare(&[0, 0], &[arc]).unwrap();
+        let run = |l: Limits| {
+            let p = plan(
+                &MoveRequest {
+                    distance: prepared.length_physical(F.position_lsb),
+                    method: Method::Order3 {
+                        vmax: l.velocity,
+                        amax: l.acceleration,
+                        jmax: l.jerk,
+                    },
+                },
+                &F,
+            )
+            .unwrap();
+            let path = prepared.fit(p.final_state.x - p.start.x);
+            let raw: Vec<Vec<i128>> = Trace::new(&p.program, p.start, F.widths)
+                .map(|t| path.at(t.state.x - p.start.x).unwrap())
+                .collect();
+            check(&raw, &raw_limits(&axes), None)
+        };
+        assert!(run(axes[0]).is_err());
+        let g = prepared.geometries()[0].scaled(F.position_lsb);
+        assert!(run(element_limits(&g, &axes, 1e9).unwrap()).is_ok());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        #[test]
+        fn every_axis_within_its_limits(
+            axes in prop::array::uniform3(axis()),
+            to in prop::array::uniform3(-20 * MM..20 * MM),
+            radius in (MM / 2)..(20 * MM),
+            start_angle in 0.0f64..std::f64::consts::TAU,
+            kind in 0usize..3,
+            ccw in any::<bool>(),
+            feed in 1.0f64..200.0,
+        ) {
+            let start = vec![0i64, 0, 0];
+            let element = match kind {
+                0 => Element::Line { to: to.to_vec() },
+                _ => {
+                    // An arc from the start around a centre `radius` away, to the point of
+                    // the circle at the angle of `to`; a helix (kind 2) climbs to `to`'s z.
+                    let centre = [
+                        -(radius as f64 * start_angle.cos()).round() as i64,
+                        -(radius as f64 * start_angle.sin()).round() as i64,
+                    ];
+                    let r = ((centre[0] as f64).powi(2) + (centre[1] as f64).powi(2)).sqrt();
+                    let end_angle = (to[1] as f64).atan2(to[0] as f64);
+                    let end = |c: i64, f: f64| c + (r * f).round() as i64;
+                    Element::Arc {
+                        plane: [0, 1],
+                        centre,
+                        ccw,
+                        to: vec![
+                            end(centre[0], end_angle.cos()),
+                            end(centre[1], end_angle.sin()),
+                            if kind == 2 { to[2] } else { 0 },
+                        ],
+                    }
+                }
+            };
+            let prepared = match prepare(&start, std::slice::from_ref(&element)) {
+                Ok(p) => p,
+                // An end point whose cell is not the circle's point there: refused, fine.
+                Err(_) => return Ok(()),
+            };
+            prop_assume!(prepared.length() > 1 << FRAC_BITS);
+            let g = prepared.geometries()[0].scaled(F.position_lsb);
+            let l = element_limits(&g, &axes, feed).unwrap();
+            let p = plan(
+                &MoveRequest {
+                    distance: prepared.length_physical(F.position_lsb),
+                    method: Method::Order3 {
+                        vmax: l.velocity,
+                        amax: l.acceleration,
+                        jmax: l.jerk,
+                    },
+                },
+                &F,
+            )
+            .unwrap();
+            prop_assume!(p.ticks_total() < 200_000);
+            let path = prepared.fit(p.final_state.x - p.start.x);
+            let raw: Vec<Vec<i128>> = Trace::new(&p.program, p.start, F.widths)
+                .map(|t| path.at(t.state.x - p.start.x).unwrap())
+                .collect();
+            if let Err(e) = check(&raw, &raw_limits(&axes), None) {
+                return Err(TestCaseError::fail(format!("{element:?} {l:?}: {e:?}")));
+            }
+            let on_grid: Vec<Vec<i128>> = raw
+                .iter()
+                .map(|p| p.iter().map(|x| x >> FRAC_BITS).collect())
+                .collect();
+            let checked = match &element {
+                Element::Line { to } => Checked::Line(Line { from: grid(&start), to: grid(to) }),
+                Element::Arc { plane, centre, ccw, to } => Checked::Arc(Arc {
+                    plane: *plane,
+                    centre: [i128::from(centre[0]), i128::from(centre[1])],
+                    direction: if *ccw { Direction::CounterClockwise } else { Direction::Clockwise },
+                    from: grid(&start),
+                    to: grid(to),
+                }),
+            };
+            let f = follow(&[checked], &on_grid, Bounds { line: 1, arc: 2 }).unwrap();
+            prop_assert!(f.is_ok(), "{element:?}: {f:?}");
+        }
+    }
 }

@@ -8,9 +8,12 @@
 //! * **Line**: `xᵢ = fromᵢ + ((r · dirᵢ) >> 62)`, `dirᵢ` the axis's share of the length
 //!   (`Δxᵢ / length`, 62 fraction bits).
 //! * **Arc** (and helix): `θ = start + sign·((r · rate) >> RATE_SHIFT)` (wrapping [`Turn`]s),
-//!   `(c, s) = cos_sin(θ)` ([`super::cordic`]); the plane's axes are
-//!   `centre + ((radius · c) >> 62)` and `centre + ((radius · s) >> 62)`; every other axis
-//!   moves as on a line, `fromᵢ + ((r · dirᵢ) >> 62)` (a helix's climb; 0 for a flat arc).
+//!   `(c, s) = cos_sin(θ)` ([`super::cordic`]), `ρ = radius + ((r · growth) >> 62)`; the
+//!   plane's axes are `centre + ((ρ · c) >> 62)` and `centre + ((ρ · s) >> 62)`; every other
+//!   axis moves as on a line, `fromᵢ + ((r · dirᵢ) >> 62)` (a helix's climb; 0 for a flat
+//!   arc). `growth` takes the radius from the start's to the end point's when the end point,
+//!   on its grid, is not quite on the circle (a spiral of a fraction of an LSB, as G-code
+//!   interpreters do).
 //!
 //! `>>` rounds toward −∞ (an arithmetic shift), the products are exact (256 bits).
 
@@ -37,8 +40,10 @@ pub enum Shape {
         plane: [usize; 2],
         /// The centre in the plane (raw).
         centre: [i128; 2],
-        /// The radius (raw).
+        /// The radius at the start (raw).
         radius: i128,
+        /// The radius's change per raw unit of `s` (62 fraction bits).
+        growth: i128,
         /// The angle at the segment's start.
         start: Turn,
         /// Turns·2⁶⁴ per raw unit of `s`, with [`RATE_SHIFT`] fraction bits (≥ 0).
@@ -79,12 +84,14 @@ impl Segment {
                 plane,
                 centre,
                 radius,
+                growth,
                 start,
                 rate,
                 ccw,
                 from,
                 dir,
             } => {
+                let rho = radius + mul_shift(r, *growth, ONE_BITS);
                 let turned = mul_shift(r, *rate, RATE_SHIFT) as u64;
                 let theta = if *ccw {
                     start.0.wrapping_add(turned)
@@ -97,8 +104,8 @@ impl Segment {
                     .zip(dir)
                     .map(|(&x, &d)| x + mul_shift(r, d, ONE_BITS))
                     .collect();
-                out[plane[0]] = centre[0] + mul_shift(*radius, c, ONE_BITS);
-                out[plane[1]] = centre[1] + mul_shift(*radius, s, ONE_BITS);
+                out[plane[0]] = centre[0] + mul_shift(rho, c, ONE_BITS);
+                out[plane[1]] = centre[1] + mul_shift(rho, s, ONE_BITS);
                 out
             }
         }
@@ -166,6 +173,7 @@ mod tests {
                 plane: [0, 1],
                 centre: [0, 0],
                 radius: 1 << 100,
+                growth: 0,
                 start: Turn(0),
                 rate: 1 << (62 + RATE_SHIFT - 100),
                 ccw,

@@ -11,16 +11,20 @@
 //!   the chain's exact displacement (the planner's quantized move, within a fraction of an
 //!   LSB of the length), so the chain's end is the path's end.
 //! * Each element starts where the rule leaves the one before it, so the axes never jump; a
-//!   line ends on its end point (within 2⁻³⁰ LSB); an arc ends on its circle at its end
-//!   point's angle: the next element starts from there. An arc that ends the path must end on
-//!   its end point's cell (its end on the circle), or it is refused.
-//! * Not built yet: the speed each element allows (curvature, per-axis limits), tangent
-//!   extension online, corners, the sequencer in the fabric (issue 22).
+//!   line ends on its end point (within 2⁻³⁰ LSB); so does an arc, its radius going from the
+//!   start's to the end point's along it (the two may differ by at most 1 LSB: an end point
+//!   rounded to the grid is rarely exactly on the circle).
+//! * [`speed`]: the limits each element allows `s` so that no axis exceeds its own.
+//! * Not built yet: tangent extension online and corners at speed (every element is planned
+//!   from rest to rest), the sequencer in the fabric (issue 22).
+
+pub mod speed;
 
 use ethnum::{I256, U256};
 use snapgen_model::path::cordic::{Turn, ONE_BITS};
 use snapgen_model::path::interp::{Path, Segment, Shape, RATE_SHIFT};
 use snapgen_model::FRAC_BITS;
+use speed::Geometry;
 
 /// One element, from where the one before it ends.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -77,28 +81,25 @@ pub enum PathError {
         /// The end's.
         end: f64,
     },
-    /// The last element, an arc, whose end on its circle is not its end point's cell.
-    #[error("the last element, an arc, ends at {reached:?}, not on its end point {to:?}: put the end point on the circle")]
-    ArcEnd {
-        /// Where its rule ends (whole LSBs).
-        reached: Vec<i128>,
-        /// Its end point.
-        to: Vec<i64>,
-    },
 }
 
 /// A path measured, ready to be fitted onto a chain's move.
 pub struct Prepared {
     start: Vec<i64>,
-    elements: Vec<Element>,
     drafts: Vec<Draft>,
     lengths: Vec<i128>,
+    geometries: Vec<Geometry>,
 }
 
 impl Prepared {
     /// The path's length in raw units of `s`.
     pub fn length(&self) -> i128 {
         self.lengths.iter().sum()
+    }
+
+    /// Each element's geometry for [`speed::element_limits`], lengths in output LSBs.
+    pub fn geometries(&self) -> &[Geometry] {
+        &self.geometries
     }
 
     /// The path's length in the chain's physical units (`format`'s LSB).
@@ -159,6 +160,7 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
     // The geometry on the grid and each element's length (raw).
     let mut drafts = Vec::new();
     let mut lengths = Vec::new();
+    let mut geometries = Vec::new();
     let mut at: Vec<i64> = start.to_vec();
     for (k, e) in elements.iter().enumerate() {
         let to = match e {
@@ -182,7 +184,16 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
                         d * d
                     })
                     .sum();
-                lengths.push(isqrt((d2 << (2 * FRAC_BITS)).as_u256()).as_i128());
+                let length = isqrt((d2 << (2 * FRAC_BITS)).as_u256()).as_i128();
+                let len = length as f64 / 2f64.powi(FRAC_BITS as i32);
+                geometries.push(Geometry::Line {
+                    shares: at
+                        .iter()
+                        .zip(to)
+                        .map(|(&a, &b)| if len > 0.0 { (b - a) as f64 / len } else { 0.0 })
+                        .collect(),
+                });
+                lengths.push(length);
                 drafts.push(Draft::Line { to: to_raw });
             }
             Element::Arc {
@@ -218,6 +229,19 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
                     .sum();
                 let len = ((rs * sweep * std::f64::consts::TAU).powi(2) + climb2).sqrt();
                 lengths.push((len * 2f64.powi(FRAC_BITS as i32)) as i128);
+                geometries.push(Geometry::Arc {
+                    plane: *plane,
+                    radius: rs,
+                    shares: (0..axes)
+                        .map(|i| {
+                            if i == p || i == q {
+                                0.0
+                            } else {
+                                (to[i] - at[i]) as f64 / len
+                            }
+                        })
+                        .collect(),
+                });
                 drafts.push(Draft::Arc {
                     plane: *plane,
                     centre: [raw(centre[0]), raw(centre[1])],
@@ -231,9 +255,9 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
     }
     Ok(Prepared {
         start: start.to_vec(),
-        elements: elements.to_vec(),
         drafts,
         lengths,
+        geometries,
     })
 }
 
@@ -241,9 +265,8 @@ impl Prepared {
     /// The interpolator's path over `s` from 0 to `total` (raw, > 0: the chain's exact
     /// displacement for the path's length), each element's share of it in proportion to its
     /// length.
-    pub fn fit(&self, total: i128) -> Result<Path, PathError> {
-        let (start, elements, drafts, lengths) =
-            (&self.start, &self.elements, &self.drafts, &self.lengths);
+    pub fn fit(&self, total: i128) -> Path {
+        let (start, drafts, lengths) = (&self.start, &self.drafts, &self.lengths);
         let axes = start.len();
         let whole = self.length().max(1);
         let total = total.max(1);
@@ -255,18 +278,12 @@ impl Prepared {
             bounds.push(((I256::from(sum) * I256::from(total)) / I256::from(whole)).as_i128());
         }
         *bounds.last_mut().expect("one element at least") = total;
-        fit_rules(start, elements, drafts, &bounds, axes)
+        fit_rules(start, drafts, &bounds, axes)
     }
 }
 
 /// The rules, each from where the one before leaves the axes.
-fn fit_rules(
-    start: &[i64],
-    elements: &[Element],
-    drafts: &[Draft],
-    bounds: &[i128],
-    axes: usize,
-) -> Result<Path, PathError> {
+fn fit_rules(start: &[i64], drafts: &[Draft], bounds: &[i128], axes: usize) -> Path {
     let mut from: Vec<i128> = start.iter().map(|&x| raw(x)).collect();
     let mut segments = Vec::new();
     for (k, d) in drafts.iter().enumerate() {
@@ -291,10 +308,15 @@ fn fit_rules(
                 let (dx, dy) = (from[p] - centre[0], from[q] - centre[1]);
                 let r2 = I256::from(dx) * I256::from(dx) + I256::from(dy) * I256::from(dy);
                 let start = (dy as f64).atan2(dx as f64) / std::f64::consts::TAU;
+                let radius = isqrt(r2.as_u256()).as_i128();
+                let (ex, ey) = (to[p] - centre[0], to[q] - centre[1]);
+                let e2 = I256::from(ex) * I256::from(ex) + I256::from(ey) * I256::from(ey);
+                let end_radius = isqrt(e2.as_u256()).as_i128();
                 Shape::Arc {
                     plane: *plane,
                     centre: *centre,
-                    radius: isqrt(r2.as_u256()).as_i128(),
+                    radius,
+                    growth: ratio(end_radius - radius, ONE_BITS, length),
                     start: Turn((start.rem_euclid(1.0) * 2f64.powi(64)) as u64),
                     rate: ratio(*sweep, RATE_SHIFT, length),
                     ccw: *ccw,
@@ -315,16 +337,7 @@ fn fit_rules(
         from = segment.at(length);
         segments.push(segment);
     }
-    if let (Some(Element::Arc { to, .. }), Some(end)) = (elements.last(), segments.last()) {
-        let reached: Vec<i128> = end.at(end.length).iter().map(|x| x >> FRAC_BITS).collect();
-        if reached.iter().zip(to).any(|(&r, &t)| r != i128::from(t)) {
-            return Err(PathError::ArcEnd {
-                reached,
-                to: to.clone(),
-            });
-        }
-    }
-    Ok(Path { segments })
+    Path { segments }
 }
 
 #[cfg(test)]
@@ -334,7 +347,7 @@ mod tests {
     /// Prepared and fitted onto its own length.
     fn made(start: &[i64], elements: &[Element]) -> Result<Path, PathError> {
         let p = prepare(start, elements)?;
-        p.fit(p.length())
+        Ok(p.fit(p.length()))
     }
 
     #[test]
@@ -342,7 +355,7 @@ mod tests {
         let p = prepare(&[0, 0], &[Element::Line { to: vec![3, 4] }]).unwrap();
         assert_eq!(p.length(), 5 << FRAC_BITS, "|(3, 4)| = 5 exactly");
         // Fitted onto a move a little longer: the end is still the end point's cell.
-        let path = p.fit((5 << FRAC_BITS) + 12345).unwrap();
+        let path = p.fit((5 << FRAC_BITS) + 12345);
         let end = path.at(path.length()).unwrap();
         assert_eq!(
             end.iter().map(|x| x >> FRAC_BITS).collect::<Vec<_>>(),
@@ -369,14 +382,16 @@ mod tests {
         assert!(matches!(e, PathError::Radius { .. }), "{e}");
         let e = made(&[10, 0], &[arc([0, 0], vec![0, 13])]).unwrap_err();
         assert!(matches!(e, PathError::Radius { .. }), "{e}");
-        // (0, 10) is on the circle of radius 10: fine; (0, 11) is 11 from the centre: within
-        // 1 LSB, but its cell is not the circle's point at that angle, and it ends the path.
-        assert!(made(&[10, 0], &[arc([0, 0], vec![0, 10])]).is_ok());
-        let e = made(&[10, 0], &[arc([0, 0], vec![0, 11])]).unwrap_err();
-        assert!(
-            e.to_string().contains("put the end point on the circle"),
-            "{e}"
-        );
+        // (0, 10) is on the circle of radius 10; (0, 11) is 1 LSB off it: a spiral of 1 LSB
+        // ends on it exactly.
+        for end in [10i64, 11] {
+            let path = made(&[10, 0], &[arc([0, 0], vec![0, end])]).unwrap();
+            let last = path.at(path.length()).unwrap();
+            assert_eq!(
+                last.iter().map(|x| x >> FRAC_BITS).collect::<Vec<_>>(),
+                vec![0, i128::from(end)]
+            );
+        }
         let flat = Element::Arc {
             plane: [0, 0],
             centre: [0, 0],

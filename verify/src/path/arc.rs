@@ -15,12 +15,16 @@
 //!   from `from` (clockwise arcs mirrored), by the half-plane each vector lies in and then the
 //!   sign of their cross product. Exact. A point within `b` of `from` or `to` on every axis
 //!   counts as on the arc (it may lie a hair outside the swept range).
-//! * **axially** (a helix's other axes), each axis `i` within `b` of
-//!   `fromᵢ + (θ/Θ)·(toᵢ − fromᵢ)`, `θ` the point's angle swept from `from` and `Θ` the arc's
-//!   sweep. The angles are `atan2` in `f64` of exact cross and dot products; the test is
-//!   `|error| + ε·(|pᵢ − fromᵢ| + |θ/Θ·(toᵢ − fromᵢ)|) ≤ b` with `ε = 10⁻¹³`, far above the
-//!   rounding of a few operations (2⁻⁵³ each), so it may refuse a point within `b` by a hair
-//!   but never accepts one beyond it.
+//! * **axially** (a helix's other axes): some point of the helix lies within `b` of `p` in the
+//!   plane and on every other axis. The helix's point at angle `θ` (swept from `from`, `Θ` the
+//!   arc's sweep) has axis `i` at `fromᵢ + (θ/Θ)·(toᵢ − fromᵢ)`; the angles whose circle point
+//!   lies within `b` of `p` in the plane are `θₚ ± δ`, `cos δ = (d² + R² − b²)/(2dR)` (`d`
+//!   the point's distance from the centre); so each axis must lie within `b` of the range the
+//!   helix takes over those angles. A steep helix needs this: a point's in-plane rounding moves
+//!   its own angle enough to move the helix's height there by many LSBs. Computed in `f64`
+//!   (the angles by `atan2` of exact cross and dot products), `δ` shrunk and the error grown
+//!   by `ε = 10⁻¹³` of the values, far above the rounding of a few operations (2⁻⁵³ each): it
+//!   may refuse a point within `b` by a hair, never accepts one beyond it.
 //!
 //! An arc sweeps at most one turn.
 
@@ -140,16 +144,26 @@ impl Arc {
         } else {
             sweep(&s, &e)
         };
-        let ratio = theta / total;
+        // The angles whose circle point lies within the bound of p in the plane.
+        let (d, r, b) = (
+            u.norm2().to_f64().unwrap_or(f64::INFINITY).sqrt(),
+            s.norm2().to_f64().unwrap_or(f64::INFINITY).sqrt(),
+            bound as f64,
+        );
+        let cos_delta = ((d * d + r * r - b * b) / (2.0 * d * r)).clamp(-1.0, 1.0);
+        let delta = cos_delta.acos() * (1.0 - EPSILON);
+        let lo = ((theta - delta) / total).clamp(0.0, 1.0);
+        let hi = ((theta + delta) / total).clamp(0.0, 1.0);
         axial.iter().all(|&i| {
             let moved = (big(p[i]) - big(self.from[i]))
                 .to_f64()
                 .unwrap_or(f64::INFINITY);
-            let want = ratio
-                * (big(self.to[i]) - big(self.from[i]))
-                    .to_f64()
-                    .unwrap_or(0.0);
-            (moved - want).abs() + EPSILON * (moved.abs() + want.abs()) <= bound as f64
+            let climb = (big(self.to[i]) - big(self.from[i]))
+                .to_f64()
+                .unwrap_or(0.0);
+            let (a, c) = (lo * climb, hi * climb);
+            let off = (a.min(c) - moved).max(moved - a.max(c)).max(0.0);
+            off + EPSILON * (moved.abs() + climb.abs()) <= b
         })
     }
 }
