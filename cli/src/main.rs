@@ -58,6 +58,10 @@ enum Command {
     /// swapped in there; every state read checked bit for bit against the plan
     /// (docs/ONLINE.md).
     Online(online::Args),
+    /// Play a G-code program (G0-G3 lines, arcs and helices) along its path on the
+    /// bit-accurate model, each block an exact stop, and check from the axes' positions that
+    /// it stays on the path and every axis within its limits on every tick.
+    Path(path::Args),
     /// Plan a move and run it on a board over a serial port: read the board's identity, plan
     /// with its Ts and format from its exact registers, configure (read back), upload, start,
     /// follow, and check the end bit for bit.
@@ -96,6 +100,7 @@ enum Command {
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Plan(a) => plan::run(a),
+        Command::Path(a) => path::run(a),
         Command::Trace(a) => trace::run(a),
         Command::Plot(a) => plot::run(a),
         Command::Verilog(a) => verilog::run(a),

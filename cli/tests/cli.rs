@@ -574,3 +574,37 @@ fn online_refuses_a_bad_script_with_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("order = 5"));
 }
+
+/// `snapgen path`: the example part is played, passes its independent check and ends where it
+/// began; a program with an unsupported word is refused with its line (exit 2) before anything
+/// moves.
+#[test]
+fn path_plays_the_example_part_and_refuses_bad_gcode() {
+    let part = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/part.ngc");
+    let csv = tmp("part.csv");
+    let out = snapgen(&["path", "--gcode", part, "--csv", csv.to_str().unwrap()]);
+    assert_ok(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("9 blocks"), "{text}");
+    assert!(
+        text.contains("within every axis's limits on every tick"),
+        "{text}"
+    );
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    let last = rows.lines().last().unwrap();
+    let xyz: Vec<f64> = last
+        .split(',')
+        .skip(2)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(
+        xyz.len() == 3 && xyz.iter().all(|v| v.abs() < 1e-9),
+        "{last}"
+    );
+    let bad = tmp("bad.ngc");
+    std::fs::write(&bad, "G21 F600\nG1 X1\nM3 S1000\nM30\n").unwrap();
+    let out = snapgen(&["path", "--gcode", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 3: M3 is not supported"), "{err}");
+}

@@ -14,9 +14,11 @@
 
 pub mod axis;
 pub mod driver;
+pub mod gcode;
 pub mod limits;
 pub mod link;
 pub mod online;
+pub mod path;
 pub mod protocol;
 pub mod send;
 pub mod serial;

@@ -9,6 +9,7 @@ pub mod experiment;
 pub mod format;
 pub mod gains;
 pub mod online;
+pub mod path;
 pub mod plan;
 pub mod plot;
 pub mod send;

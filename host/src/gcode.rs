@@ -1,0 +1,356 @@
+//! G-code to path elements: the words a CNC integrator writes for lines and arcs, read into
+//! [`snapgen_plan::path::Element`]s on the output grid, every error with its line before
+//! anything moves.
+//!
+//! Parsed by the `g-code` crate (exact decimals); interpreted here with its modal state:
+//!
+//! | words | meaning |
+//! |---|---|
+//! | `G0` | rapid: a line at the axes' own limits |
+//! | `G1 X Y Z F` | a line at feed `F` |
+//! | `G2`/`G3` `X Y Z` with `I J K` or `R` | a clockwise / counter-clockwise arc (a helix when the third axis moves); `I J K` the centre from the start (incremental), `R` its radius (negative: more than half a turn); the start's point again with `I J K`: a full turn |
+//! | `G17` `G18` `G19` | the arc's plane: XY, ZX, YZ (counter-clockwise from the first axis toward the second) |
+//! | `G20` `G21` | inches, millimetres (the machine's unit is the millimetre) |
+//! | `G90` `G91` | absolute, incremental coordinates |
+//! | `F` | feed in units per minute |
+//! | `N` | line number (ignored) |
+//! | `M2` `M30` | end of program (what follows is not read) |
+//! | `( … )` `; …` | comments |
+//!
+//! Anything else — another G or M code, a word such as `S`, `T`, `A` — is refused with its
+//! line, as is a feed move before any `F`, an arc whose centre or radius does not fit its end
+//! point, or a program without an end. The machine starts at 0 on every axis.
+
+use g_code::emit::{Field, Value};
+use g_code::parse::ast::Spanned;
+use snapgen_plan::path::Element;
+
+/// One motion block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Its line in the file (from 1).
+    pub line: usize,
+    /// The element it moves along.
+    pub element: Element,
+    /// Its feed (mm/s), or None for a rapid (the axes' own limits).
+    pub feed: Option<f64>,
+}
+
+/// What is wrong with a program.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum GcodeError {
+    /// The text does not parse as G-code.
+    #[error("line {line}, column {column}: not G-code (expected {expected})")]
+    Parse {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// What the parser expected.
+        expected: String,
+    },
+    /// A word this reader does not carry out.
+    #[error("line {line}: {word} is not supported (supported: G0-G3, G17-G19, G20, G21, G90, G91, X Y Z I J K R F N, M2, M30)")]
+    Unsupported {
+        /// Line.
+        line: usize,
+        /// The word.
+        word: String,
+    },
+    /// A feed move before any feed rate.
+    #[error("line {line}: a feed move (G1, G2, G3) needs a feed rate: give F (units/min) on it or before it")]
+    NoFeed {
+        /// Line.
+        line: usize,
+    },
+    /// A feed rate that is not a positive number.
+    #[error("line {line}: F{value} is not a positive feed rate")]
+    BadFeed {
+        /// Line.
+        line: usize,
+        /// The value.
+        value: f64,
+    },
+    /// An arc without a centre or radius, or whose radius cannot reach its end point.
+    #[error("line {line}: {why}")]
+    Arc {
+        /// Line.
+        line: usize,
+        /// Why.
+        why: String,
+    },
+    /// A program that does not end with M2 or M30.
+    #[error("the program has no end: finish it with M2 or M30")]
+    NoEnd,
+}
+
+/// The modal state.
+struct Modal {
+    motion: u32,
+    plane: [usize; 2],
+    inch: bool,
+    incremental: bool,
+    feed: Option<f64>,
+}
+
+/// The value of a word, as a number.
+fn number(f: &Field) -> Option<f64> {
+    match &f.value {
+        Value::Rational(_) | Value::Integer(_) | Value::Float(_) => f.value.as_f64(),
+        Value::String(_) => None,
+    }
+}
+
+/// Reads `src` into motion blocks on a grid of `lsb` mm (module documentation).
+pub fn read(src: &str, lsb: f64) -> Result<Vec<Block>, GcodeError> {
+    let file = g_code::parse::file_parser(src).map_err(|e| GcodeError::Parse {
+        line: e.location.line,
+        column: e.location.column,
+        expected: e.expected.to_string(),
+    })?;
+    let line_of = |offset: usize| src[..offset.min(src.len())].matches('\n').count() + 1;
+    let mut m = Modal {
+        motion: 0,
+        plane: [0, 1],
+        inch: false,
+        incremental: false,
+        feed: None,
+    };
+    let mut at = [0i64; 3];
+    let mut blocks = Vec::new();
+    for l in file.iter() {
+        let line = line_of(l.span().0);
+        let unsupported = |word: String| GcodeError::Unsupported { line, word };
+        let mut words: Vec<(char, f64)> = Vec::new();
+        let mut moved = false;
+        let mut end = false;
+        for parsed in l.iter_fields() {
+            let f = Field::from(parsed);
+            let letters = f.letters.to_ascii_uppercase();
+            let value =
+                number(&f).ok_or_else(|| unsupported(format!("{letters} with a string")))?;
+            let mut chars = letters.chars();
+            let (Some(letter), None) = (chars.next(), chars.next()) else {
+                return Err(unsupported(letters));
+            };
+            let code = (value.fract() == 0.0 && value >= 0.0).then_some(value as u32);
+            match (letter, code) {
+                ('G', Some(c @ 0..=3)) => {
+                    m.motion = c;
+                    moved = true;
+                }
+                ('G', Some(17)) => m.plane = [0, 1],
+                ('G', Some(18)) => m.plane = [2, 0],
+                ('G', Some(19)) => m.plane = [1, 2],
+                ('G', Some(20)) => m.inch = true,
+                ('G', Some(21)) => m.inch = false,
+                ('G', Some(90)) => m.incremental = false,
+                ('G', Some(91)) => m.incremental = true,
+                ('M', Some(2 | 30)) => end = true,
+                ('G' | 'M', _) => return Err(unsupported(format!("{letter}{value}"))),
+                ('X' | 'Y' | 'Z' | 'I' | 'J' | 'K' | 'R', _) => {
+                    words.push((letter, value));
+                    if matches!(letter, 'X' | 'Y' | 'Z') {
+                        moved = true;
+                    }
+                }
+                ('F', _) => words.push((letter, value)),
+                ('N', _) => {}
+                _ => return Err(unsupported(format!("{letter}{value}"))),
+            }
+        }
+        let scale = if m.inch { 25.4 } else { 1.0 };
+        let word = |c: char| words.iter().rev().find(|w| w.0 == c).map(|w| w.1 * scale);
+        if let Some(f) = words.iter().rev().find(|w| w.0 == 'F').map(|w| w.1) {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(GcodeError::BadFeed { line, value: f });
+            }
+            m.feed = Some(f * scale / 60.0);
+        }
+        let cells = |mm: f64| (mm / lsb).round() as i64;
+        if moved && words.iter().any(|w| matches!(w.0, 'X' | 'Y' | 'Z')) {
+            let mut to = at;
+            for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                if let Some(v) = word(c) {
+                    to[k] = if m.incremental {
+                        at[k] + cells(v)
+                    } else {
+                        cells(v)
+                    };
+                }
+            }
+            let feed = if m.motion == 0 {
+                None
+            } else {
+                Some(m.feed.ok_or(GcodeError::NoFeed { line })?)
+            };
+            let element = match m.motion {
+                0 | 1 => Element::Line { to: to.to_vec() },
+                _ => arc(line, &m, at, to, lsb, |c| word(c).map(cells))?,
+            };
+            if to != at || !matches!(element, Element::Line { .. }) {
+                blocks.push(Block {
+                    line,
+                    element,
+                    feed,
+                });
+            }
+            at = to;
+        }
+        if end {
+            return Ok(blocks);
+        }
+    }
+    Err(GcodeError::NoEnd)
+}
+
+/// The arc of a G2/G3 block from `at` to `to` (module documentation).
+fn arc(
+    line: usize,
+    m: &Modal,
+    at: [i64; 3],
+    to: [i64; 3],
+    lsb: f64,
+    word: impl Fn(char) -> Option<i64>,
+) -> Result<Element, GcodeError> {
+    let [p, q] = m.plane;
+    let letters = ['I', 'J', 'K'];
+    let ccw = m.motion == 3;
+    let bad = |why: String| GcodeError::Arc { line, why };
+    let centre = match (word(letters[p]), word(letters[q]), word('R')) {
+        (None, None, None) => {
+            return Err(bad(
+                "an arc needs its centre (I J K) or its radius (R)".into()
+            ))
+        }
+        (_, _, Some(r)) if word(letters[p]).is_none() && word(letters[q]).is_none() => {
+            let (sx, sy, ex, ey) = (at[p] as f64, at[q] as f64, to[p] as f64, to[q] as f64);
+            let chord = (ex - sx).hypot(ey - sy);
+            if chord == 0.0 {
+                return Err(bad(
+                    "a full turn cannot be given by its radius: give its centre (I J K)".into(),
+                ));
+            }
+            let r = r as f64;
+            let h2 = r * r - chord * chord / 4.0;
+            if h2 < -1.0 {
+                return Err(bad(format!(
+                    "radius {} mm is shorter than half the chord to the end point ({} mm)",
+                    r.abs() * lsb,
+                    chord / 2.0 * lsb
+                )));
+            }
+            let h = h2.max(0.0).sqrt();
+            // The centre on the chord's left (counter-clockwise arc of at most half a turn)
+            // or right; R < 0 asks for the longer arc.
+            let (ux, uy) = ((ex - sx) / chord, (ey - sy) / chord);
+            let left = ccw == (r > 0.0);
+            let side = if left { 1.0 } else { -1.0 };
+            [
+                ((sx + ex) / 2.0 - side * h * uy).round() as i64,
+                ((sy + ey) / 2.0 + side * h * ux).round() as i64,
+            ]
+        }
+        (i, j, None) => [at[p] + i.unwrap_or(0), at[q] + j.unwrap_or(0)],
+        _ => {
+            return Err(bad(
+                "give an arc's centre (I J K) or its radius (R), not both".into(),
+            ))
+        }
+    };
+    Ok(Element::Arc {
+        plane: m.plane,
+        centre,
+        ccw,
+        to: to.to_vec(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NM: f64 = 1e-6;
+
+    #[test]
+    fn lines_arcs_and_modes() {
+        let src = "G21 G90 G17 (a slot)\nG0 X10 Y0\nG1 X30 F600 ; mm/min\nG3 X30 Y40 I0 J20\nG2 X10 Y40 Z-1 R10\nG91 G1 Y-40\nM30\nG1 X99\n";
+        let b = read(src, NM).unwrap();
+        assert_eq!(b.len(), 5);
+        let mm = |x: i64| x * 1_000_000;
+        assert_eq!(
+            b[0].element,
+            Element::Line {
+                to: vec![mm(10), 0, 0]
+            }
+        );
+        assert_eq!((b[0].line, b[0].feed), (2, None));
+        assert_eq!(b[1].feed, Some(10.0));
+        assert_eq!(
+            b[2].element,
+            Element::Arc {
+                plane: [0, 1],
+                centre: [mm(30), mm(20)],
+                ccw: true,
+                to: vec![mm(30), mm(40), 0],
+            }
+        );
+        // R10 from (30, 40) to (10, 40), clockwise: the centre (20, 40) (a half turn).
+        let Element::Arc {
+            centre, ccw, to, ..
+        } = &b[3].element
+        else {
+            panic!()
+        };
+        assert_eq!(
+            (*centre, *ccw, to.clone()),
+            ([mm(20), mm(40)], false, vec![mm(10), mm(40), -mm(1)])
+        );
+        assert_eq!(
+            b[4].element,
+            Element::Line {
+                to: vec![mm(10), 0, -mm(1)]
+            }
+        );
+        assert_eq!(b[4].line, 6);
+    }
+
+    #[test]
+    fn inches_planes_and_full_turns() {
+        let src = "G20 G18 F10\nG1 X1\nG2 X1 Z0 I1 K0\nM2\n";
+        let b = read(src, NM).unwrap();
+        let inch = 25_400_000;
+        assert_eq!(b[0].feed, Some(10.0 * 25.4 / 60.0));
+        assert_eq!(
+            b[1].element,
+            Element::Arc {
+                plane: [2, 0],
+                centre: [0, 2 * inch],
+                ccw: false,
+                to: vec![inch, 0, 0],
+            }
+        );
+    }
+
+    #[test]
+    fn bad_programs_name_their_line() {
+        let cases = [
+            ("G1 X1 F100\nM3 S1000\nM2\n", "line 2: M3 is not supported"),
+            ("G1 X1\nM2\n", "line 1: a feed move"),
+            ("G1 X1 F100\nG2 X2\nM2\n", "line 2: an arc needs its centre"),
+            (
+                "F100\nG2 X10 R2\nM2\n",
+                "line 2: radius 2 mm is shorter than half the chord to the end point (5 mm)",
+            ),
+            ("F100\nG2 X0 Y0 R2\nM2\n", "line 2: a full turn cannot"),
+            ("G1 X1 F100\n", "no end"),
+            ("G1 X1 F-5\nM2\n", "F-5 is not a positive"),
+            ("G1 A3 F100\nM2\n", "line 1: A3 is not supported"),
+            ("G41 X1 F100\nM2\n", "line 1: G41 is not supported"),
+        ];
+        for (src, want) in cases {
+            let e = read(src, NM).unwrap_err().to_string();
+            assert!(e.contains(want), "{src:?}: {e}");
+        }
+    }
+}
