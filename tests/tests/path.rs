@@ -30,9 +30,9 @@ const J: f64 = 100_000.0;
 const R: f64 = 20.0;
 
 /// A slot in XY climbing in z at one slope, 1 in 10, all along (so that the helix meets the
-/// lines tangentially in space: a flat line met by a climbing helix is a corner, which the
-/// per-axis check below finds at once, a jerk 25 times the bound): a line 30 mm along x, a
-/// helical half turn of radius 20 mm, a line 30 mm back.
+/// lines tangentially in space: a flat line met by a climbing helix is a corner,
+/// `a_corner_in_space_is_caught`): a line 30 mm along x, a helical half turn of radius
+/// 20 mm, a line 30 mm back.
 fn points() -> [Vec<i64>; 4] {
     let climb = |mm: f64| (mm * 0.1 * MM as f64).round() as i64;
     let arc = std::f64::consts::PI * R;
@@ -50,7 +50,11 @@ fn grid(p: &[i64]) -> Vec<i128> {
 
 /// The raw positions of every axis on every tick, from rest to rest.
 fn played() -> Vec<Vec<i128>> {
-    let [start, a, b, c] = points();
+    played_through(points())
+}
+
+/// The same along other points.
+fn played_through([start, a, b, c]: [Vec<i64>; 4]) -> Vec<Vec<i128>> {
     let prepared = prepare(
         &start,
         &[
@@ -125,9 +129,8 @@ fn a_helical_slot_stays_on_its_path_and_ends_on_its_point() {
         .is_err());
 }
 
-#[test]
-fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
-    let raw = played();
+/// The axis limits of the slot: the path's plus what its arc adds (module documentation).
+fn slot_limits() -> (AxisLimits, i128) {
     let s = |q| F.scale(q);
     let slack = 1.0 + 1e-6;
     let limits = AxisLimits {
@@ -137,7 +140,15 @@ fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
             * s(Quantity::Jerk)
             * slack) as i128,
     };
-    let speed = (V * s(Quantity::Velocity) * slack) as i128;
+    (limits, (V * s(Quantity::Velocity) * slack) as i128)
+}
+
+#[test]
+fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
+    let raw = played();
+    let s = |q| F.scale(q);
+    let slack = 1.0 + 1e-6;
+    let (limits, speed) = slot_limits();
     let peaks = check(&raw, &[limits; 3], Some(speed)).unwrap_or_else(|e| panic!("{e:?}"));
     // The term the arc adds is there, where the line meets it: y stands still along the
     // first line, then takes the centripetal acceleration within a tick or two, a jerk of the
@@ -156,6 +167,21 @@ fn each_axis_moves_within_the_path_limits_and_what_the_arc_adds() {
     let jerk = |i: usize| peaks.axes[i][2].as_f64() / s(Quantity::Jerk);
     // z climbs at a constant share of the path speed (1 in √101): within the path's.
     assert!(jerk(2) <= J / 101f64.sqrt() * 1.001, "{}", jerk(2));
+}
+
+/// A flat line met by a climbing helix is a corner in space: z's velocity steps within a
+/// tick, and the per-axis check finds it there, far beyond the bound.
+#[test]
+fn a_corner_in_space_is_caught() {
+    let [start, a, b, c] = points();
+    let flat_a = vec![a[0], a[1], 0];
+    let raw = played_through([start, flat_a, b, c]);
+    let (limits, speed) = slot_limits();
+    let e = check(&raw, &[limits; 3], Some(speed)).unwrap_err();
+    // Where the line meets the helix: the first tick y moves.
+    let meets = raw.iter().position(|p| p[1] != raw[0][1]).unwrap();
+    assert!(e.tick.abs_diff(meets) <= 3, "{e:?} at {meets}");
+    assert!(e.value > e.limit * 2, "{e:?}");
 }
 
 mod elements {
