@@ -79,10 +79,27 @@ pub enum GcodeError {
         /// Why.
         why: String,
     },
+    /// A point beyond what the axes' output can hold.
+    #[error(
+        "line {line}: {axis} at {mm} mm is beyond the axes' reach (±{limit} mm: 2^31 output LSBs)"
+    )]
+    Range {
+        /// Line.
+        line: usize,
+        /// The axis.
+        axis: char,
+        /// Where it was sent (mm).
+        mm: f64,
+        /// The reach (mm).
+        limit: f64,
+    },
     /// A program that does not end with M2 or M30.
     #[error("the program has no end: finish it with M2 or M30")]
     NoEnd,
 }
+
+/// The largest position magnitude (output LSBs): the fabric's 32-bit position output.
+const POSITION_LIMIT: f64 = 2147483647.0;
 
 /// The modal state.
 struct Modal {
@@ -108,7 +125,11 @@ pub fn read(src: &str, lsb: f64) -> Result<Vec<Block>, GcodeError> {
         column: e.location.column,
         expected: e.expected.to_string(),
     })?;
-    let line_of = |offset: usize| src[..offset.min(src.len())].matches('\n').count() + 1;
+    // Where each line begins, for a block's line number from its byte offset.
+    let starts: Vec<usize> = std::iter::once(0)
+        .chain(src.match_indices('\n').map(|(k, _)| k + 1))
+        .collect();
+    let line_of = |offset: usize| starts.partition_point(|&s| s <= offset);
     let mut m = Modal {
         motion: 0,
         plane: [0, 1],
@@ -168,15 +189,30 @@ pub fn read(src: &str, lsb: f64) -> Result<Vec<Block>, GcodeError> {
             m.feed = Some(f * scale / 60.0);
         }
         let cells = |mm: f64| (mm / lsb).round() as i64;
-        if moved && words.iter().any(|w| matches!(w.0, 'X' | 'Y' | 'Z')) {
+        let has = |letters: &[char]| words.iter().any(|w| letters.contains(&w.0));
+        let arc_words = has(&['I', 'J', 'K', 'R']);
+        if arc_words && !(moved && m.motion >= 2) {
+            return Err(GcodeError::Arc {
+                line,
+                why: "I J K R belong to an arc (G2, G3)".into(),
+            });
+        }
+        // A move: coordinates, or an arc's centre alone (the start's point again: a full turn).
+        if moved && (has(&['X', 'Y', 'Z']) || arc_words) {
             let mut to = at;
             for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                 if let Some(v) = word(c) {
-                    to[k] = if m.incremental {
-                        at[k] + cells(v)
-                    } else {
-                        cells(v)
-                    };
+                    let v = v / lsb;
+                    let target = if m.incremental { at[k] as f64 + v } else { v };
+                    if target.is_nan() || target.abs() >= POSITION_LIMIT {
+                        return Err(GcodeError::Range {
+                            line,
+                            axis: c,
+                            mm: target * lsb,
+                            limit: POSITION_LIMIT * lsb,
+                        });
+                    }
+                    to[k] = target.round() as i64;
                 }
             }
             let feed = if m.motion == 0 {
@@ -217,6 +253,12 @@ fn arc(
     let letters = ['I', 'J', 'K'];
     let ccw = m.motion == 3;
     let bad = |why: String| GcodeError::Arc { line, why };
+    let off_plane = (0..3).find(|&i| i != p && i != q).map(|i| letters[i]);
+    if let Some(c) = off_plane.filter(|&c| word(c).is_some()) {
+        return Err(bad(format!(
+            "{c} is not an offset in this arc's plane (G17: I J, G18: K I, G19: J K)"
+        )));
+    }
     let centre = match (word(letters[p]), word(letters[q]), word('R')) {
         (None, None, None) => {
             return Err(bad(
@@ -251,13 +293,26 @@ fn arc(
                 ((sy + ey) / 2.0 + side * h * ux).round() as i64,
             ]
         }
-        (i, j, None) => [at[p] + i.unwrap_or(0), at[q] + j.unwrap_or(0)],
+        (i, j, None) => [
+            at[p].saturating_add(i.unwrap_or(0)),
+            at[q].saturating_add(j.unwrap_or(0)),
+        ],
         _ => {
             return Err(bad(
                 "give an arc's centre (I J K) or its radius (R), not both".into(),
             ))
         }
     };
+    if centre
+        .iter()
+        .any(|&c| c.unsigned_abs() as f64 >= 2.0 * POSITION_LIMIT)
+    {
+        return Err(bad(format!(
+            "the arc's centre ({} mm, {} mm) is beyond the axes' reach",
+            centre[0] as f64 * lsb,
+            centre[1] as f64 * lsb
+        )));
+    }
     Ok(Element::Arc {
         plane: m.plane,
         centre,
@@ -333,6 +388,21 @@ mod tests {
     }
 
     #[test]
+    fn a_centre_alone_is_a_full_turn() {
+        let b = read("F60\nG1 X5\nG2 I5 J0\nM2\n", NM).unwrap();
+        assert_eq!(
+            b[1].element,
+            Element::Arc {
+                plane: [0, 1],
+                centre: [10_000_000, 0],
+                ccw: false,
+                to: vec![5_000_000, 0, 0],
+            }
+        );
+        assert_eq!(b[1].line, 3);
+    }
+
+    #[test]
     fn bad_programs_name_their_line() {
         let cases = [
             ("G1 X1 F100\nM3 S1000\nM2\n", "line 2: M3 is not supported"),
@@ -347,6 +417,15 @@ mod tests {
             ("G1 X1 F-5\nM2\n", "F-5 is not a positive"),
             ("G1 A3 F100\nM2\n", "line 1: A3 is not supported"),
             ("G41 X1 F100\nM2\n", "line 1: G41 is not supported"),
+            ("G1 X1 I2 F100\nM2\n", "line 1: I J K R belong to an arc"),
+            (
+                "G17 F100\nG2 X1 I1 K1\nM2\n",
+                "line 2: K is not an offset in this arc's plane",
+            ),
+            (
+                "G1 X3000 F100\nM2\n",
+                "line 1: X at 3000 mm is beyond the axes' reach",
+            ),
         ];
         for (src, want) in cases {
             let e = read(src, NM).unwrap_err().to_string();

@@ -83,13 +83,24 @@ pub struct Checked {
 /// Plays `blocks` from the origin with `axes` (X, Y, Z) limits in `format` (mm, its LSB and
 /// Ts).
 pub fn play(blocks: &[Block], axes: &[Limits; 3], format: &Format) -> Result<Run, PlayError> {
+    // Every block prepared first: a block that cannot be is refused before anything moves.
     let mut at = vec![0i64; 3];
-    let mut trace: Vec<Vec<i128>> = vec![at.iter().map(|&x| snapgen_plan::path::raw(x)).collect()];
-    let mut played = Vec::new();
+    let mut prepared_all = Vec::new();
     for b in blocks {
+        let prepared =
+            prepare(&at, std::slice::from_ref(&b.element)).map_err(|source| PlayError::Path {
+                line: b.line,
+                source,
+            })?;
+        prepared_all.push(prepared);
+        at = match &b.element {
+            Element::Line { to } | Element::Arc { to, .. } => to.clone(),
+        };
+    }
+    let mut trace: Vec<Vec<i128>> = vec![vec![snapgen_plan::path::raw(0); 3]];
+    let mut played = Vec::new();
+    for (b, prepared) in blocks.iter().zip(&prepared_all) {
         let line = b.line;
-        let prepared = prepare(&at, std::slice::from_ref(&b.element))
-            .map_err(|source| PlayError::Path { line, source })?;
         let g = prepared.geometries()[0].scaled(format.position_lsb);
         let limits = element_limits(&g, axes, b.feed.unwrap_or(f64::INFINITY))
             .ok_or(PlayError::Still { line })?;
@@ -122,9 +133,6 @@ pub fn play(blocks: &[Block], axes: &[Limits; 3], format: &Format) -> Result<Run
             limits,
             ticks: p.ticks_total(),
         });
-        at = match &b.element {
-            Element::Line { to } | Element::Arc { to, .. } => to.clone(),
-        };
     }
     Ok(Run {
         blocks: played,

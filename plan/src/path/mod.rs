@@ -20,8 +20,8 @@
 
 pub mod speed;
 
-use ethnum::{I256, U256};
-use snapgen_model::path::cordic::{Turn, ONE_BITS};
+use ethnum::I256;
+use snapgen_model::path::cordic::{isqrt, Turn, ONE_BITS};
 use snapgen_model::path::interp::{Path, Segment, Shape, RATE_SHIFT};
 use snapgen_model::FRAC_BITS;
 use speed::Geometry;
@@ -53,6 +53,14 @@ pub enum PathError {
     /// No element.
     #[error("the path has no element")]
     Empty,
+    /// A point or centre too far out for the interpolator's registers.
+    #[error("element {element}: a coordinate of {value} LSB is beyond ±2^40 LSB")]
+    Range {
+        /// The element.
+        element: usize,
+        /// The coordinate.
+        value: i64,
+    },
     /// A point with another number of axes than the start.
     #[error("element {element} has {found} axes, the start {axes}: give every axis of each point")]
     Axes {
@@ -113,21 +121,6 @@ pub fn raw(x: i64) -> i128 {
     (i128::from(x) << FRAC_BITS) + (1i128 << (FRAC_BITS - 1))
 }
 
-/// `⌊√n⌋`.
-fn isqrt(n: U256) -> U256 {
-    if n < 2 {
-        return n;
-    }
-    let mut x = U256::ONE << (256 - n.leading_zeros()).div_ceil(2);
-    loop {
-        let y = (x + n / x) >> 1;
-        if y >= x {
-            return x;
-        }
-        x = y;
-    }
-}
-
 /// `round(a · 2^shift / b)`, `b > 0`.
 fn ratio(a: i128, shift: u32, b: i128) -> i128 {
     let n = I256::from(a) << shift;
@@ -172,6 +165,18 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
                 axes,
                 found: to.len(),
             });
+        }
+        let centre: &[i64] = match e {
+            Element::Arc { centre, .. } => centre,
+            Element::Line { .. } => &[],
+        };
+        let far = at
+            .iter()
+            .chain(to)
+            .chain(centre)
+            .find(|x| x.unsigned_abs() >= 1 << 40);
+        if let Some(&value) = far {
+            return Err(PathError::Range { element: k, value });
         }
         let to_raw: Vec<i128> = to.iter().map(|&x| raw(x)).collect();
         match e {
@@ -392,6 +397,15 @@ mod tests {
                 vec![0, i128::from(end)]
             );
         }
+        assert!(matches!(
+            made(
+                &[0, 0],
+                &[Element::Line {
+                    to: vec![1 << 41, 0]
+                }]
+            ),
+            Err(PathError::Range { .. })
+        ));
         let flat = Element::Arc {
             plane: [0, 0],
             centre: [0, 0],

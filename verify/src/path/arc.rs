@@ -15,16 +15,18 @@
 //!   from `from` (clockwise arcs mirrored), by the half-plane each vector lies in and then the
 //!   sign of their cross product. Exact. A point within `b` of `from` or `to` on every axis
 //!   counts as on the arc (it may lie a hair outside the swept range).
-//! * **axially** (a helix's other axes): some point of the helix lies within `b` of `p` in the
-//!   plane and on every other axis. The helix's point at angle `θ` (swept from `from`, `Θ` the
-//!   arc's sweep) has axis `i` at `fromᵢ + (θ/Θ)·(toᵢ − fromᵢ)`; the angles whose circle point
-//!   lies within `b` of `p` in the plane are `θₚ ± δ`, `cos δ = (d² + R² − b²)/(2dR)` (`d`
-//!   the point's distance from the centre); so each axis must lie within `b` of the range the
-//!   helix takes over those angles. A steep helix needs this: a point's in-plane rounding moves
-//!   its own angle enough to move the helix's height there by many LSBs. Computed in `f64`
-//!   (the angles by `atan2` of exact cross and dot products), `δ` shrunk and the error grown
-//!   by `ε = 10⁻¹³` of the values, far above the rounding of a few operations (2⁻⁵³ each): it
-//!   may refuse a point within `b` by a hair, never accepts one beyond it.
+//! * **axially**: an axis off the plane that does not climb lies within `b` of where it
+//!   stands (exact). On a helix, some one point of it lies within `b` of `p` in the plane and
+//!   on every climbing axis: its point at the share `t` of the sweep `Θ` has axis `i` at
+//!   `fromᵢ + t·(toᵢ − fromᵢ)`; the angles whose circle point lies within `b` of `p` in the
+//!   plane are `θₚ ± δ`, `sin²(δ/2) = (b² − (d − R)²)/(4dR)` (`d` the point's distance from
+//!   the centre, `d − R` from the exact `d² − R²`); so the shares allowed by the plane and by
+//!   every climbing axis must meet. A steep helix needs the window: a point's in-plane
+//!   rounding moves its own angle enough to move the helix's height there by many LSBs.
+//!   Computed in `f64` (the angles by `atan2` of exact cross and dot products), `δ` and the
+//!   axial windows shrunk by `ε = 10⁻¹³` of the values and the window of angles by atan2's
+//!   own rounding, far above the rounding of these few well-conditioned operations (2⁻⁵³
+//!   each): it may refuse a point within `b` by a hair, and is not meant to accept one beyond.
 //!
 //! An arc sweeps at most one turn.
 
@@ -92,8 +94,8 @@ impl Arc {
                 "the plane's axes {p} and {q} must be two different axes of the {axes}"
             ));
         }
-        if self.rel(&self.from).norm2().is_zero() {
-            return Err("the arc starts on its centre (radius 0)".into());
+        if self.rel(&self.from).norm2().is_zero() || self.rel(&self.to).norm2().is_zero() {
+            return Err("the arc starts or ends on its centre (radius 0)".into());
         }
         Ok(())
     }
@@ -132,10 +134,13 @@ impl Arc {
         }
         let [a, c] = self.plane;
         let axial: Vec<usize> = (0..p.len()).filter(|&i| i != a && i != c).collect();
-        if axial
-            .iter()
-            .all(|&i| self.from[i] == self.to[i] && p[i] == self.from[i])
-        {
+        // Axes that do not climb: exactly within the bound of where they stand.
+        let (still, climbing): (Vec<usize>, Vec<usize>) =
+            axial.iter().partition(|&&i| self.from[i] == self.to[i]);
+        if still.iter().any(|&i| (p[i] - self.from[i]).abs() > bound) {
+            return false;
+        }
+        if climbing.is_empty() {
             return true;
         }
         let theta = sweep(&s, &u);
@@ -144,27 +149,66 @@ impl Arc {
         } else {
             sweep(&s, &e)
         };
-        // The angles whose circle point lies within the bound of p in the plane.
+        // The angles whose circle point lies within the bound of p in the plane: θₚ ± δ with
+        // sin²(δ/2) = (b² − (d − R)²) / (4dR), d − R = (D − Q)/(d + R) from the exact D − Q
+        // (well conditioned where acos of a cosine near 1 is not).
+        let dq = (u.norm2() - s.norm2()).to_f64().unwrap_or(f64::INFINITY);
         let (d, r, b) = (
             u.norm2().to_f64().unwrap_or(f64::INFINITY).sqrt(),
             s.norm2().to_f64().unwrap_or(f64::INFINITY).sqrt(),
             bound as f64,
         );
-        let cos_delta = ((d * d + r * r - b * b) / (2.0 * d * r)).clamp(-1.0, 1.0);
-        let delta = cos_delta.acos() * (1.0 - EPSILON);
-        let lo = ((theta - delta) / total).clamp(0.0, 1.0);
-        let hi = ((theta + delta) / total).clamp(0.0, 1.0);
-        axial.iter().all(|&i| {
+        let gap = dq / (d + r);
+        let half = ((b * b - gap * gap) / (4.0 * d * r))
+            .max(0.0)
+            .sqrt()
+            .min(1.0);
+        let delta = 2.0 * half.asin() * (1.0 - EPSILON);
+        // The share of the sweep the helix may be at: within those angles, on the arc, and for
+        // every climbing axis where its height is within the bound (one share for all: one
+        // point of the helix).
+        // atan2's rounding, a few units of 2⁻⁵³ of the angles, taken off the window too.
+        let angle_error = 4.0 * f64::EPSILON * (1.0 + theta + total);
+        let mut lo = ((theta - delta + angle_error) / total).max(0.0);
+        let mut hi = ((theta + delta - angle_error) / total).min(1.0);
+        for &i in &climbing {
             let moved = (big(p[i]) - big(self.from[i]))
                 .to_f64()
                 .unwrap_or(f64::INFINITY);
             let climb = (big(self.to[i]) - big(self.from[i]))
                 .to_f64()
-                .unwrap_or(0.0);
-            let (a, c) = (lo * climb, hi * climb);
-            let off = (a.min(c) - moved).max(moved - a.max(c)).max(0.0);
-            off + EPSILON * (moved.abs() + climb.abs()) <= b
-        })
+                .unwrap_or(f64::INFINITY);
+            let slack = EPSILON * (moved.abs() + climb.abs());
+            let (x, y) = ((moved - b + slack) / climb, (moved + b - slack) / climb);
+            lo = lo.max(x.min(y));
+            hi = hi.min(x.max(y));
+        }
+        lo <= hi
+    }
+}
+
+impl Arc {
+    /// The share of the sweep `p`'s angle has reached (0 at the start, 1 at the end), and the
+    /// arc's length, in `f64`: for following its progress, not for the bound.
+    pub(crate) fn progress(&self, p: &[i128]) -> (f64, f64) {
+        let (s, e, u) = (self.rel(&self.from), self.rel(&self.to), self.rel(p));
+        let full = e.cross(&s).is_zero() && e.dot(&s).is_positive();
+        let total = if full {
+            std::f64::consts::TAU
+        } else {
+            sweep(&s, &e)
+        };
+        let r = s.norm2().to_f64().unwrap_or(f64::INFINITY).sqrt();
+        let [a, c] = self.plane;
+        let climb2: f64 = (0..p.len())
+            .filter(|&i| i != a && i != c)
+            .map(|i| ((self.to[i] - self.from[i]) as f64).powi(2))
+            .sum();
+        let length = ((r * total).powi(2) + climb2).sqrt();
+        if u.norm2().is_zero() {
+            return (0.0, length);
+        }
+        ((sweep(&s, &u) / total).clamp(0.0, 1.0), length)
     }
 }
 
@@ -293,6 +337,10 @@ mod tests {
     fn malformed_arcs_are_refused() {
         let mut a = arc(Direction::CounterClockwise, &[0, 0], &[1, 0]);
         assert!(a.check(2).unwrap_err().contains("radius 0"));
+        a.from = vec![1, 0];
+        a.to = vec![0, 0];
+        assert!(a.check(2).unwrap_err().contains("radius 0"));
+        a.to = vec![1, 0];
         a.from = vec![1, 0];
         a.plane = [1, 1];
         assert!(a.check(2).is_err());

@@ -78,6 +78,24 @@ impl Line {
     }
 }
 
+impl Line {
+    /// How far along the segment `p`'s projection lies (0 at the start, 1 at the end,
+    /// clamped), and the segment's length, in `f64`: for following its progress, not for the
+    /// bound.
+    pub(crate) fn progress(&self, p: &[i128]) -> (f64, f64) {
+        let (mut dot, mut len2) = (0.0, 0.0);
+        for ((&a, &e), &q) in self.from.iter().zip(&self.to).zip(p) {
+            let d = (e - a) as f64;
+            dot += (q - a) as f64 * d;
+            len2 += d * d;
+        }
+        if len2 == 0.0 {
+            return (1.0, 0.0);
+        }
+        ((dot / len2).clamp(0.0, 1.0), len2.sqrt())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

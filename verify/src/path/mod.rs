@@ -6,15 +6,18 @@
 //! interpolator computes: it takes the path as the user programmed it (end points, centres,
 //! directions on the integer grid) and the integer positions the axes took, tick by tick.
 //!
-//! * **Geometry** ([`follow`]): every point of the trace must lie on the path within a bound,
-//!   the elements visited in their order (a point may lie on an element after the current one,
-//!   never before it), and the trace must end exactly on the last element's end point. A
-//!   line's bound is per axis ([`line`]: a point of the exact segment exists from which every
-//!   axis is within `b`), an arc's is radial in its plane and per axis off it ([`arc`]).
-//!   Lines and the radial and angular tests of arcs are exact (integer arithmetic of any
-//!   size); only a helix's axial test uses floating point, with its rounding error counted
-//!   against the trace (it may refuse a point within the bound by a hair, never accept one
-//!   beyond it).
+//! * **Geometry** ([`follow`]): the trace starts exactly on the path's start, every point of
+//!   it lies on the path within a bound, the elements visited in their order (a point may lie
+//!   on an element after the current one, never before it; an element is left only once the
+//!   trace has come within a step of its end, following its progress a step at a time, and
+//!   every junction a step passes must lie within that step's box widened by the bound: an
+//!   element passed over within one tick, never a detour skipped nor a full turn cut short),
+//!   and the trace ends exactly on the last element's end point. A line's bound is per axis ([`line`]: a point of the exact segment
+//!   exists from which every axis is within `b`), an arc's is radial in its plane and per axis
+//!   off it ([`arc`]). Lines and the radial and angular tests of arcs are exact (integer
+//!   arithmetic of any size); only a helix's axial test uses floating point, with margins for
+//!   its rounding counted against the trace (it may refuse a point within the bound by a
+//!   hair).
 //! * **Limits** ([`limits`]): each axis's velocity, acceleration and jerk, as the first, second
 //!   and third differences of its positions from tick to tick, and the path's speed (the
 //!   Euclidean length of a tick's step), never above their limits.
@@ -56,6 +59,14 @@ impl Element {
         match self {
             Element::Line(l) => &l.to,
             Element::Arc(a) => &a.to,
+        }
+    }
+
+    /// How far along the element `p` is (0 to 1) and the element's length (`f64`).
+    fn progress(&self, p: &[i128]) -> (f64, f64) {
+        match self {
+            Element::Line(l) => l.progress(p),
+            Element::Arc(a) => a.progress(p),
         }
     }
 
@@ -134,6 +145,13 @@ pub enum PathError {
 /// Where a trace left its path.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Deviation {
+    /// The trace does not start on the path's start.
+    Start {
+        /// Its first point.
+        point: Vec<i128>,
+        /// The path's start.
+        start: Vec<i128>,
+    },
     /// The point of `tick` lies on no element from the current one on.
     OffPath {
         /// The tick.
@@ -155,7 +173,8 @@ pub enum Deviation {
 /// What [`follow`] found.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Followed {
-    /// For each element, the first tick whose point lay on it (None: passed within a tick).
+    /// For each element, the first tick whose point lay on it (None: passed over within one
+    /// tick's step).
     pub entered: Vec<Option<usize>>,
 }
 
@@ -208,24 +227,59 @@ pub fn follow(
         });
     }
     let mut entered = vec![None; path.len()];
+    let start = path[0].from();
+    if let Some(p) = trace.first().filter(|p| p.as_slice() != start) {
+        return Ok(Err(Deviation::Start {
+            point: p.clone(),
+            start: start.to_vec(),
+        }));
+    }
+    let reach = bounds.line.max(bounds.arc);
     let mut at = 0;
+    // How far the trace has come along the current element (0 to 1).
+    let mut reached = 0.0f64;
     for (tick, p) in trace.iter().enumerate() {
-        if path[at].holds(p, bounds) {
-            entered[at].get_or_insert(tick);
-            continue;
-        }
-        match (at + 1..path.len()).find(|&k| path[k].holds(p, bounds)) {
-            Some(k) => {
+        let prev = &trace[tick.saturating_sub(1)];
+        // This step's length, and the share of the current element it and the bound cover.
+        let step = prev
+            .iter()
+            .zip(p)
+            .map(|(&a, &b)| ((b - a) as f64).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let (progress, length) = path[at].progress(p);
+        // (Twice the step: a chord of an arc is shorter than the arc, at most by π/2.)
+        let slack = (2.0 * step + 2.0 * reach as f64 + 1.0) / length.max(1.0);
+        // Leave the current element only from its end (within a step), for the first later
+        // element that holds the point, every junction on the way within the step's box.
+        if reached >= 1.0 - slack {
+            let within = |q: &[i128]| {
+                q.iter()
+                    .zip(prev.iter().zip(p))
+                    .all(|(&x, (&a, &b))| a.min(b) - reach <= x && x <= a.max(b) + reach)
+            };
+            let next = (at + 1..path.len())
+                .take_while(|&k| within(path[k].from()))
+                .find(|&k| path[k].holds(p, bounds));
+            if let Some(k) = next {
                 at = k;
                 entered[k] = Some(tick);
+                reached = path[k].progress(p).0;
+                continue;
             }
-            None => {
-                return Ok(Err(Deviation::OffPath {
-                    tick,
-                    element: at,
-                    point: p.clone(),
-                }))
-            }
+        }
+        if !path[at].holds(p, bounds) {
+            return Ok(Err(Deviation::OffPath {
+                tick,
+                element: at,
+                point: p.clone(),
+            }));
+        }
+        entered[at].get_or_insert(tick);
+        // Progress counts only as far as a step can go (a point just behind a full turn's
+        // start is not its end).
+        if progress <= reached + slack {
+            reached = reached.max(progress);
         }
     }
     let end = path[path.len() - 1].to();
@@ -299,7 +353,8 @@ mod tests {
         let path = slot();
         let trace = sampled(97);
         let f = follow(&path, &trace, Bounds::all(1)).unwrap().unwrap();
-        assert_eq!(f.entered, vec![Some(0), Some(98), Some(195)]);
+        // Each element entered on the point that ends the one before (it holds on both).
+        assert_eq!(f.entered, vec![Some(0), Some(97), Some(194)]);
         // One point moved off the path by 2 or more across it (along a line it would stay on
         // the path): off the path there. On the arc: 3 out or in along its radius, or 2 up.
         let across = |p: &[i128], k: usize| -> Vec<i128> {
@@ -345,6 +400,59 @@ mod tests {
         let mut skip = trace.clone();
         skip.drain(99..140);
         assert!(follow(&path, &skip, Bounds::all(1)).unwrap().is_ok());
+    }
+
+    #[test]
+    fn a_detour_or_a_turn_cannot_be_skipped_and_the_start_is_the_path_s() {
+        // Out along x, up 10 in y and back down (a retract), then on along x: a trace
+        // straight along x passes the retract's ends but not the retract itself.
+        let line = |from: [i128; 2], to: [i128; 2]| {
+            Element::Line(Line {
+                from: from.to_vec(),
+                to: to.to_vec(),
+            })
+        };
+        let path = [
+            line([0, 0], [10, 0]),
+            line([10, 0], [10, 10]),
+            line([10, 10], [10, 0]),
+            line([10, 0], [20, 0]),
+        ];
+        let straight: Vec<Vec<i128>> = (0..=20).map(|x| vec![x, 0]).collect();
+        assert!(matches!(
+            follow(&path, &straight, Bounds::all(1)).unwrap(),
+            Err(Deviation::OffPath { .. })
+        ));
+        let mut with_retract: Vec<Vec<i128>> = (0..=10).map(|x| vec![x, 0]).collect();
+        with_retract.extend((1..=10).map(|y| vec![10, y]));
+        with_retract.extend((0..10).rev().map(|y| vec![10, y]));
+        with_retract.extend((11..=20).map(|x| vec![x, 0]));
+        let f = follow(&path, &with_retract, Bounds::all(0))
+            .unwrap()
+            .unwrap();
+        assert!(f.entered.iter().all(Option::is_some), "{f:?}");
+        // A full turn then a line from its end (its start): leaving onto the line at once,
+        // the turn cut short, is off the path.
+        let turn = [
+            Element::Arc(Arc {
+                plane: [0, 1],
+                centre: [0, 100],
+                direction: Direction::CounterClockwise,
+                from: vec![0, 0],
+                to: vec![0, 0],
+            }),
+            line([0, 0], [50, 0]),
+        ];
+        let cut: Vec<Vec<i128>> = (0..=50).map(|x| vec![x, 0]).collect();
+        assert!(matches!(
+            follow(&turn, &cut, Bounds::all(1)).unwrap(),
+            Err(Deviation::OffPath { .. })
+        ));
+        // A trace that does not begin on the start.
+        assert!(matches!(
+            follow(&path, &with_retract[1..], Bounds::all(1)).unwrap(),
+            Err(Deviation::Start { .. })
+        ));
     }
 
     #[test]
