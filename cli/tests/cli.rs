@@ -601,6 +601,12 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
         xyz.len() == 3 && xyz.iter().all(|v| v.abs() < 1e-9),
         "{last}"
     );
+    let out = snapgen(&["path", "--gcode", part, "--json"]);
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["checked"], true);
+    assert_eq!(v["blocks"].as_array().unwrap().len(), 9);
+    assert_eq!(v["blocks"][0]["kind"], "rapid");
     let bad = tmp("bad.ngc");
     std::fs::write(&bad, "G21 F600\nG1 X1\nM3 S1000\nM30\n").unwrap();
     let out = snapgen(&["path", "--gcode", bad.to_str().unwrap()]);

@@ -1,8 +1,8 @@
 //! `snapgen path`: a G-code program of lines, arcs and helices played along its path on the
 //! bit-accurate model (X, Y, Z), each block an exact stop, and checked from the axes'
 //! positions alone: on the path (lines 1 LSB on every axis, arcs 2) and within every axis's
-//! limits on every tick (`snapgen_host::path`). Prints each block's outcome; `--csv` writes
-//! the per-tick trace. Exit 1 when the check fails, 2 for a program it cannot read or play.
+//! limits on every tick (`snapgen_host::path`). Prints each block's outcome (`--json`: one
+//! object); `--csv` writes the per-tick trace. Exit 1 when the check fails, 2 for a program it cannot read or play.
 //!
 //! Not built yet (issue 22): tangent blocks joined at speed, the feed override, corners with
 //! a blend, the N-axis fabric, `--board fabric` and `--port`, the SVG picture.
@@ -43,6 +43,10 @@ pub struct Args {
     /// Write the per-tick trace (tick, time, X, Y, Z in mm) to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Print one JSON object instead of the table: each block (line, kind, length, limits,
+    /// ticks), the ticks and duration, each axis's peaks, and the check's outcome.
+    #[arg(long)]
+    json: bool,
 }
 
 /// The path left its program or an axis its limits (exit 1; the report is printed).
@@ -80,48 +84,83 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let axes = [axis; 3];
     let run = play(&blocks, &axes, &format)
         .map_err(|e| InputError::Board(format!("{}: {e}", a.gcode.display())))?;
-    println!("line  kind    length mm   v mm/s   a mm/s²   j mm/s³     ticks");
-    for b in &run.blocks {
-        println!(
-            "{:>4}  {:<6} {:>10.4} {:>8.3} {:>9.1} {:>9.0} {:>9}",
-            b.line,
-            b.kind,
-            b.length,
-            b.limits.velocity,
-            b.limits.acceleration,
-            b.limits.jerk,
-            b.ticks
-        );
-    }
     let ticks = run.trace.len() as u64 - 1;
-    println!(
-        "{} blocks, {ticks} ticks ({:.3} s)",
-        run.blocks.len(),
-        ticks as f64 * a.ts
-    );
     if let Some(path) = &a.csv {
         write_csv(&run.trace, &format, path)
             .with_context(|| format!("cannot write {}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
     let c = verify(&run, &blocks, &axes, &format);
-    for (name, [v, aa, j]) in ["X", "Y", "Z"].iter().zip(&c.peaks) {
-        println!("{name}: peaks {v:.3} mm/s, {aa:.1} mm/s², {j:.0} mm/s³");
-    }
-    match (&c.deviation, &c.exceeded) {
-        (None, None) => {
+    let passed = c.deviation.is_none() && c.exceeded.is_none();
+    if a.json {
+        let blocks: Vec<serde_json::Value> = run
+            .blocks
+            .iter()
+            .map(|b| {
+                serde_json::json!({
+                    "line": b.line,
+                    "kind": b.kind,
+                    "length_mm": b.length,
+                    "velocity": b.limits.velocity,
+                    "acceleration": b.limits.acceleration,
+                    "jerk": b.limits.jerk,
+                    "ticks": b.ticks,
+                })
+            })
+            .collect();
+        let peaks: Vec<serde_json::Value> = ["X", "Y", "Z"]
+            .iter()
+            .zip(&c.peaks)
+            .map(|(n, [v, aa, j])| {
+                serde_json::json!({"axis": n, "velocity": v, "acceleration": aa, "jerk": j})
+            })
+            .collect();
+        let v = serde_json::json!({
+            "blocks": blocks,
+            "ticks": ticks,
+            "duration_s": ticks as f64 * a.ts,
+            "peaks": peaks,
+            "checked": passed,
+            "deviation": c.deviation.as_ref().map(|d| format!("{d:?}")),
+            "exceeded": c.exceeded.as_ref().map(|e| format!("{e:?}")),
+        });
+        println!("{v}");
+    } else {
+        println!("line  kind    length mm   v mm/s   a mm/s²   j mm/s³     ticks");
+        for b in &run.blocks {
+            println!(
+                "{:>4}  {:<6} {:>10.4} {:>8.3} {:>9.1} {:>9.0} {:>9}",
+                b.line,
+                b.kind,
+                b.length,
+                b.limits.velocity,
+                b.limits.acceleration,
+                b.limits.jerk,
+                b.ticks
+            );
+        }
+        println!(
+            "{} blocks, {ticks} ticks ({:.3} s)",
+            run.blocks.len(),
+            ticks as f64 * a.ts
+        );
+        for (name, [v, aa, j]) in ["X", "Y", "Z"].iter().zip(&c.peaks) {
+            println!("{name}: peaks {v:.3} mm/s, {aa:.1} mm/s², {j:.0} mm/s³");
+        }
+        if passed {
             println!("checked from the positions: on the path (lines 1 LSB, arcs 2) and within every axis's limits on every tick");
-            Ok(())
         }
-        (d, e) => {
-            if let Some(d) = d {
-                println!("OFF THE PATH: {d:?}");
-            }
-            if let Some(e) = e {
-                println!("OVER A LIMIT: {e:?}");
-            }
-            Err(CheckFailed.into())
+        if let Some(d) = &c.deviation {
+            println!("OFF THE PATH: {d:?}");
         }
+        if let Some(e) = &c.exceeded {
+            println!("OVER A LIMIT: {e:?}");
+        }
+    }
+    if passed {
+        Ok(())
+    } else {
+        Err(CheckFailed.into())
     }
 }
 
