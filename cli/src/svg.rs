@@ -187,3 +187,111 @@ pub fn write_loop_svg(
     root.present()?;
     Ok(())
 }
+
+/// A path played on several axes (`snapgen path --svg`): the path in the XY plane, then each
+/// axis's velocity, acceleration and jerk against time, from the differences of its raw
+/// positions (per-bucket minima and maxima, so one-tick spikes stay visible).
+pub fn write_path_svg(
+    trace: &[Vec<i128>],
+    format: &Format,
+    title: &str,
+    path: &Path,
+) -> Result<(), PlotError> {
+    let half = 1i128 << (snapgen_model::FRAC_BITS - 1);
+    let unit = format.position_lsb / 2f64.powi(snapgen_model::FRAC_BITS as i32);
+    let mm = |x: i128| (x - half) as f64 * unit;
+    let axes = trace.first().map_or(0, Vec::len);
+    // Per axis and tick: velocity, acceleration, jerk (units/s^k) from the raw differences.
+    let scale = [
+        format.scale(Physical::Velocity),
+        format.scale(Physical::Acceleration),
+        format.scale(Physical::Jerk),
+    ];
+    let n = trace.len() as u64;
+    let per = (n / BUCKETS).max(1);
+    // [quantity][axis] -> buckets of (t, lo, hi)
+    let mut series: Vec<Vec<Vec<(f64, f64, f64)>>> = vec![vec![Vec::new(); axes]; 3];
+    for i in 0..axes {
+        let (mut v0, mut a0, mut x0) = (0i128, 0i128, trace[0][i]);
+        for (k, p) in trace.iter().enumerate() {
+            let v = p[i] - x0;
+            let a = v - v0;
+            let j = a - a0;
+            (x0, v0, a0) = (p[i], v, a);
+            let t = k as f64 * format.ts;
+            for (q, raw) in [v, a, j].into_iter().enumerate() {
+                let y = raw as f64 / scale[q];
+                let s = &mut series[q][i];
+                match s.last_mut() {
+                    Some(b) if (b.0 / format.ts) as u64 / per == k as u64 / per => {
+                        b.1 = b.1.min(y);
+                        b.2 = b.2.max(y);
+                    }
+                    _ => s.push((t, y, y)),
+                }
+            }
+        }
+    }
+    let root = SVGBackend::new(path, (1000, 1400)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (head, body) = root.split_vertically(40);
+    head.titled(title, ("sans-serif", 20))?;
+    let (top, rest) = body.split_vertically(500);
+    // The path in the XY plane.
+    let step = (trace.len() / 20_000).max(1);
+    let xy: Vec<(f64, f64)> = trace
+        .iter()
+        .step_by(step)
+        .chain(trace.last())
+        .map(|p| (mm(p[0]), mm(p.get(1).copied().unwrap_or(half))))
+        .collect();
+    let (x_lo, x_hi) = xy
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.0), h.max(p.0))
+        });
+    let (y_lo, y_hi) = xy
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.1), h.max(p.1))
+        });
+    let pad = ((x_hi - x_lo).max(y_hi - y_lo) * 0.05).max(1e-9);
+    let mut chart = ChartBuilder::on(&top)
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(60)
+        .caption("path, XY plane (mm)", ("sans-serif", 16))
+        .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))?;
+    chart.configure_mesh().x_desc("X").y_desc("Y").draw()?;
+    chart.draw_series(LineSeries::new(xy, &BLUE))?;
+    let t_end = (n.max(2) - 1) as f64 * format.ts;
+    let names = ["velocity (mm/s)", "acceleration (mm/s^2)", "jerk (mm/s^3)"];
+    let colors = [&RED, &GREEN, &BLUE];
+    for (q, area) in rest.split_evenly((3, 1)).iter().enumerate() {
+        let all = series[q].iter().flatten();
+        let lo = all.clone().map(|b| b.1).fold(f64::INFINITY, f64::min);
+        let hi = all.map(|b| b.2).fold(f64::NEG_INFINITY, f64::max);
+        let pad = ((hi - lo) * 0.05).max(1e-12);
+        let mut chart = ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(90)
+            .caption(
+                format!("{} — X red, Y green, Z blue", names[q]),
+                ("sans-serif", 16),
+            )
+            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_label_formatter(&|y| format!("{y:.3e}"))
+            .draw()?;
+        for (i, s) in series[q].iter().enumerate() {
+            let color = colors[i % colors.len()];
+            chart.draw_series(LineSeries::new(s.iter().map(|b| (b.0, b.2)), color))?;
+            chart.draw_series(LineSeries::new(s.iter().map(|b| (b.0, b.1)), color))?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}

@@ -582,7 +582,16 @@ fn online_refuses_a_bad_script_with_exit_2() {
 fn path_plays_the_example_part_and_refuses_bad_gcode() {
     let part = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/part.ngc");
     let csv = tmp("part.csv");
-    let out = snapgen(&["path", "--gcode", part, "--csv", csv.to_str().unwrap()]);
+    let svg = tmp("part.svg");
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        part,
+        "--csv",
+        csv.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
     assert_ok(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("9 blocks"), "{text}");
@@ -590,6 +599,8 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
         text.contains("within every axis's limits on every tick"),
         "{text}"
     );
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.contains("path, XY plane") && picture.contains("jerk (mm/s^3)"));
     let rows = std::fs::read_to_string(&csv).unwrap();
     let last = rows.lines().last().unwrap();
     let xyz: Vec<f64> = last

@@ -2,10 +2,12 @@
 //! bit-accurate model (X, Y, Z), each block an exact stop, and checked from the axes'
 //! positions alone: on the path (lines 1 LSB on every axis, arcs 2) and within every axis's
 //! limits on every tick (`snapgen_host::path`). Prints each block's outcome (`--json`: one
-//! object); `--csv` writes the per-tick trace. Exit 1 when the check fails, 2 for a program it cannot read or play.
+//! object); `--csv` writes the per-tick trace, `--svg` the path in the XY plane and each axis's
+//! velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read or play.
 //!
 //! Not built yet (issue 22): tangent blocks joined at speed, the feed override, corners with
-//! a blend, the N-axis fabric, `--board fabric` and `--port`, the SVG picture.
+//! a blend, the N-axis fabric, `--board fabric` and `--port`; the picture does not draw the
+//! measured deviation.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -43,6 +45,10 @@ pub struct Args {
     /// Write the per-tick trace (tick, time, X, Y, Z in mm) to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Draw the path in the XY plane and each axis's velocity, acceleration and jerk against
+    /// time into this SVG file.
+    #[arg(long)]
+    svg: Option<PathBuf>,
     /// Print one JSON object instead of the table: each block (line, kind, length, limits,
     /// ticks), the ticks and duration, each axis's peaks, and the check's outcome.
     #[arg(long)]
@@ -88,6 +94,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(path) = &a.csv {
         write_csv(&run.trace, &format, path)
             .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &a.svg {
+        let title = format!("{}", a.gcode.display());
+        crate::svg::write_path_svg(&run.trace, &format, &title, path)
+            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
     let c = verify(&run, &blocks, &axes, &format);
