@@ -60,6 +60,34 @@ pub fn write_svg(plan: &Plan, title: &str, path: &Path) -> Result<(), PlotError>
     write_program_svg(&plan.program, plan.start, &plan.format, title, &[], path)
 }
 
+/// A panel of values in `y` against time from 0 to `t_end` (s), its caption and mesh drawn.
+fn time_panel<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: &str,
+    t_end: f64,
+    y: (f64, f64),
+) -> Result<
+    ChartContext<
+        'a,
+        SVGBackend<'b>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    PlotError,
+> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(90)
+        .caption(caption, ("sans-serif", 16))
+        .build_cartesian_2d(0.0..t_end, y.0..y.1)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_label_formatter(&|y| format!("{y:.3e}"))
+        .draw()?;
+    Ok(chart)
+}
+
 /// Draws the five panels of `program` played from `start` into `path`, with a vertical line
 /// at each of `events` (s from the start).
 pub fn write_program_svg(
@@ -92,20 +120,8 @@ pub fn write_program_svg(
             .map(|b| b.hi[i])
             .fold(f64::NEG_INFINITY, f64::max);
         let pad = ((hi - lo) * 0.05).max(1e-12);
-        let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(90)
-            .caption(
-                format!("{} ({})", names[i].0, names[i].1),
-                ("sans-serif", 16),
-            )
-            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_label_formatter(&|y| format!("{y:.3e}"))
-            .draw()?;
+        let caption = format!("{} ({})", names[i].0, names[i].1);
+        let mut chart = time_panel(area, &caption, t_end, (lo - pad, hi + pad))?;
         // The envelope: lower and upper edge of every bucket.
         let color = colors[i];
         chart.draw_series(LineSeries::new(data.iter().map(|b| (b.t, b.hi[i])), color))?;
@@ -272,20 +288,8 @@ pub fn write_path_svg(
         let lo = all.clone().map(|b| b.1).fold(f64::INFINITY, f64::min);
         let hi = all.map(|b| b.2).fold(f64::NEG_INFINITY, f64::max);
         let pad = ((hi - lo) * 0.05).max(1e-12);
-        let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(90)
-            .caption(
-                format!("{} — X red, Y green, Z blue", names[q]),
-                ("sans-serif", 16),
-            )
-            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_label_formatter(&|y| format!("{y:.3e}"))
-            .draw()?;
+        let caption = format!("{} — X red, Y green, Z blue", names[q]);
+        let mut chart = time_panel(area, &caption, t_end, (lo - pad, hi + pad))?;
         for (i, s) in series[q].iter().enumerate() {
             let color = colors[i % colors.len()];
             chart.draw_series(LineSeries::new(s.iter().map(|b| (b.0, b.2)), color))?;
