@@ -196,7 +196,6 @@ impl Executor {
     /// One clock.
     pub fn clock(&mut self, i: &ExecutorInputs) -> ExecutorOutputs {
         let before = self.out;
-        // Pulses last one clock.
         // Pulses last one clock; the values they carry are held (the core reads them with
         // their pulse only).
         let c = &mut self.out.command;
@@ -320,22 +319,10 @@ impl Executor {
             }
         }
         if i.following_fault && o.amplifier {
-            o.command.abort_move = true;
-            o.command.stop = false;
-            o.command.start = false;
-            o.command.swap = false;
-            o.amplifier = false;
-            o.state = AxisState::ErrorStop;
-            o.error = ErrorId::FollowingError;
+            disable_at_once(o, ErrorId::FollowingError);
         }
         if i.estop && !(s == AxisState::ErrorStop && before.error == ErrorId::EmergencyStop) {
-            o.command.abort_move = true;
-            o.command.stop = false;
-            o.command.start = false;
-            o.command.swap = false;
-            o.amplifier = false;
-            o.state = AxisState::ErrorStop;
-            o.error = ErrorId::EmergencyStop;
+            disable_at_once(o, ErrorId::EmergencyStop);
         }
         // A stop or an abort cancels an armed swap, and its program, planned for the swap's
         // tick, never plays from another state: the standby bank is emptied.
@@ -365,6 +352,19 @@ fn stop_pair_valid(cfg: Config, p: Param, value: i128) -> bool {
         _ => return true,
     }
     limits.valid()
+}
+
+/// A fault that disables the amplifier at once (the following error, the emergency stop): the
+/// move aborted (v, a and j zeroed), no stop, start or swap taken this clock, ErrorStop with
+/// `error`.
+fn disable_at_once(o: &mut ExecutorOutputs, error: ErrorId) {
+    o.command.abort_move = true;
+    o.command.stop = false;
+    o.command.start = false;
+    o.command.swap = false;
+    o.amplifier = false;
+    o.state = AxisState::ErrorStop;
+    o.error = error;
 }
 
 fn nak(cmd: u8, seq: u8, reason: Reason) -> ReplyDesc {
