@@ -53,6 +53,7 @@ fn mv(position: f64, velocity: f64, jerk: f64, buffer_mode: BufferMode) -> Motio
         deceleration: 3000.0,
         jerk,
         buffer_mode,
+        path: None,
     }
 }
 

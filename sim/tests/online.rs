@@ -42,6 +42,7 @@ fn mv(position: f64, velocity: f64, mode: BufferMode) -> MotionCommand {
         deceleration: 3000.0,
         jerk: 500_000.0,
         buffer_mode: mode,
+        path: None,
     }
 }
 
@@ -569,6 +570,7 @@ fn random_scripts_land_where_the_plan_says() {
                     deceleration: 1000.0 + rnd() * 4000.0,
                     jerk: 5e4 + rnd() * 5e5,
                     buffer_mode: mode,
+                    path: None,
                 })
             } else if r < 0.65 {
                 Action::Command(MotionCommand::MoveVelocity {

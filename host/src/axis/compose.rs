@@ -76,7 +76,31 @@ impl HostAxis {
         if let Request::Override(k) = req {
             return self.plan_override(at, k);
         }
+        // The move playing at `at`, replanned to blend, turning back (its target too near to
+        // pass at the blend, and a replan to rest from where it is overshooting): it plays on
+        // unchanged instead, as when it cannot be replanned at all.
+        let playing = self
+            .timeline
+            .parts
+            .iter()
+            .find(|p| p.end_tick() > at)
+            .map(|p| p.command);
         match self.plan_change_with(at, req, true, false) {
+            Ok(c)
+                if self.blends(req)
+                    && playing.is_some_and(|p| self.turns_back(&c, p, at))
+                    && self.plan_change_with(at, req, false, false).is_ok() =>
+            {
+                let mut c = self.plan_change_with(at, req, false, false)?;
+                if let Request::Command(k) = req {
+                    c.notes.push((
+                        k,
+                        "the previous move would have turned back to blend from where it was: buffered instead"
+                            .into(),
+                    ));
+                }
+                Ok(c)
+            }
             Err(_) if self.blends(req) => {
                 let mut c = self.plan_change_with(at, req, false, false)?;
                 if let Request::Command(k) = req {
@@ -120,10 +144,28 @@ impl HostAxis {
                 replanned
             };
         }
+        // A change the move playing at `at` cannot follow without turning back (its target
+        // too near to slow to the new speed, or to the blend it asks, in time): that move
+        // plays on as planned, the override acts from the next one.
+        if k > 0.0
+            && replanned
+                .as_ref()
+                .is_ok_and(|c| self.turns_back(c, p.command, at))
+        {
+            let kept = self.plan_change_with(at, Request::Override(k), false, true);
+            if kept
+                .as_ref()
+                .is_ok_and(|c| !self.turns_back(c, p.command, at))
+            {
+                return kept;
+            }
+        }
         let keeps = k > 0.0
             && self.slows_to_its_end(p, at)
-            && matches!(self.commands[p.command].command,
-                MotionCommand::MoveAbsolute { velocity, .. } if velocity * k >= self.speed_at(at));
+            && self.commands[p.command]
+                .command
+                .set_speed(k)
+                .is_some_and(|v| v >= self.speed_at(at));
         if !keeps {
             return replanned;
         }
@@ -167,6 +209,28 @@ impl HostAxis {
             }
         }
         true
+    }
+
+    /// True when change `c` makes command `command`'s motion from tick `at` turn back against
+    /// the direction it moves in at `at` (an overshoot of its target and a return), judged
+    /// at every segment's end and middle.
+    fn turns_back(&self, c: &Change, command: usize, at: u64) -> bool {
+        let w = &self.settings.format.widths;
+        let dir = self.timeline.state_at(at, &self.settings.format).v.signum();
+        c.timeline
+            .parts
+            .iter()
+            .filter(|q| q.command == command && q.end_tick() > at)
+            .any(|q| {
+                let mut tick = 0u64;
+                q.program.segments.iter().any(|s| {
+                    let half = tick + u64::from(s.ticks) / 2;
+                    tick += u64::from(s.ticks);
+                    [half, tick]
+                        .iter()
+                        .any(|&t| q.start.after_ticks(&q.program, t, w).v * dir < 0)
+                })
+            })
     }
 
     /// The speed at tick `at` (unit/s).
@@ -428,6 +492,7 @@ mod tests {
             deceleration: 3000.0,
             jerk: 200_000.0,
             buffer_mode: BufferMode::Aborting,
+            path: None,
         }
     }
 
@@ -510,6 +575,7 @@ mod tests {
             deceleration: 3000.0,
             jerk: 500_000.0,
             buffer_mode,
+            path: None,
         };
         let first = axis.submit(move_to(3.0, 100.0, BufferMode::Aborting));
         let next = axis.submit(move_to(5.0, 60.0, BufferMode::BlendingLow));

@@ -89,6 +89,10 @@ pub enum MotionCommand {
         /// How it follows the move before.
         #[serde(default)]
         buffer_mode: BufferMode,
+        /// On a path (an axis group's motion on its path length, `crate::path`): the speeds
+        /// the element's geometry allows, which neither the override nor a blend may pass.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        path: Option<OnPath>,
     },
     /// MC_MoveVelocity: reach and hold a signed velocity (always Aborting).
     MoveVelocity {
@@ -110,7 +114,31 @@ pub enum MotionCommand {
     },
 }
 
+/// The speeds an element of a path allows its move on the path length (unit/s, > 0).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OnPath {
+    /// Along the element (the geometry's limit: the feed override is cut to it).
+    pub velocity: f64,
+    /// At its start, the speed a blend into it aims at: its junction's, lowered by the
+    /// look-ahead so that the path can still brake where it must.
+    pub entry: f64,
+    /// At its start, the most its junction with the element before allows (a curvature jump
+    /// or a small kink at speed costs a jerk there: `snapgen_plan::path::junction`); a blend
+    /// that cannot slow to `entry` in time passes at up to this, never faster.
+    pub junction: f64,
+}
+
 impl MotionCommand {
+    /// A move's set speed at override `k`: its velocity times `k`, cut to its path's limit.
+    pub fn set_speed(&self, k: f64) -> Option<f64> {
+        match *self {
+            MotionCommand::MoveAbsolute { velocity, path, .. } => {
+                Some(path.map_or(velocity * k, |p| (velocity * k).min(p.velocity)))
+            }
+            _ => None,
+        }
+    }
+
     /// The function block's name.
     pub fn name(&self) -> &'static str {
         match self {

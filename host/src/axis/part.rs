@@ -7,7 +7,7 @@ use snapgen_model::format::{Format, Quantity};
 use snapgen_model::program::{Program, Segment};
 use snapgen_plan::online::{plan_online, OnlineError, OnlineLimits, OnlineOrder, OnlineTarget};
 
-use super::{scaled, AxisErrorId, BufferMode, Goal, HostAxis, MotionCommand};
+use super::{scaled, AxisErrorId, BufferMode, Goal, HostAxis, MotionCommand, OnPath};
 
 impl HostAxis {
     /// The velocity the timeline's last part would pass its target at with command `next`
@@ -64,12 +64,22 @@ pub(super) fn check_inputs(c: &MotionCommand, f: &Format) -> Result<(), AxisErro
             acceleration,
             deceleration,
             jerk,
+            path,
             ..
         } => {
             positive("velocity", velocity)?;
             positive("acceleration", acceleration)?;
             positive("deceleration", deceleration)?;
             positive("jerk", jerk)?;
+            if let Some(p) = path {
+                positive("path velocity", p.velocity)?;
+                if !(p.entry >= 0.0 && p.junction >= p.entry && p.junction.is_finite()) {
+                    return Err(AxisErrorId::InvalidInput(format!(
+                        "MC_MoveAbsolute path entry = {}, junction = {}: give finite speeds with 0 ≤ entry ≤ junction",
+                        p.entry, p.junction
+                    )));
+                }
+            }
             let most = f.physical_max(Quantity::Position) * 0.5;
             if !position.is_finite() || position.abs() > most {
                 return Err(AxisErrorId::InvalidInput(format!(
@@ -167,6 +177,7 @@ pub(super) fn plan_part(
             acceleration,
             deceleration,
             jerk,
+            path,
             ..
         } => {
             let l = OnlineLimits {
@@ -204,8 +215,15 @@ pub(super) fn plan_part(
                 return Ok((p, e, goal, false, Some(STOPPED_ON_TARGET.into())));
             }
             let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
+            // On a path, the element's geometry caps the set speed and the junction's the
+            // blend, whatever the override (and a blend is never passed faster: below).
+            let (aim, junction) = (blend_cap(path, next, false), blend_cap(path, next, true));
             let l = scaled(l, k);
-            let vb = vb * k;
+            let l = OnlineLimits {
+                velocity: path.map_or(l.velocity, |p| l.velocity.min(p.velocity)),
+                ..l
+            };
+            let vb = (vb * k).clamp(-aim, aim);
             let l = OnlineLimits {
                 velocity: l.velocity.max(vb.abs()),
                 ..l
@@ -234,11 +252,38 @@ pub(super) fn plan_part(
             };
             match run(at(vb), l) {
                 Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
+                Err(OnlineError::NotRealisable(_)) if vb != 0.0 => {
+                    // No exact program passes the blend point at that velocity: on a path, a
+                    // slightly slower pass; else as buffered.
+                    let slower = path.and_then(|_| {
+                        SLOWER.iter().find_map(|&f| {
+                            let v = vb.abs() * f;
+                            blend(v * vb.signum()).ok().map(|r| (v, r))
+                        })
+                    });
+                    match slower {
+                        Some((v, (p, e))) => Ok((
+                            p,
+                            e,
+                            Goal::Position {
+                                cell,
+                                velocity: v * vb.signum(),
+                            },
+                            false,
+                            Some(format!(
+                                "no exact program passes the blend point at {:.3}: passed at {v:.3} instead",
+                                vb.abs()
+                            )),
+                        )),
+                        None => buffered(),
+                    }
+                }
                 Err(OnlineError::BlendUnreachable) if vb != 0.0 => {
                     // Too fast to slow to the blend velocity by the blend point (an override
-                    // cut on a short move): the lowest blend velocity that can be reached, up
-                    // to the speed the axis reaches releasing its acceleration at full jerk
-                    // (seed 002 eq 32), found to 1/64 of the way; else as buffered.
+                    // cut on a short move): the lowest
+                    // blend velocity that can be reached, up to the speed the axis reaches
+                    // releasing its acceleration at full jerk (seed 002 eq 32), found to 1/64
+                    // of the way; else as buffered.
                     let to = |q, r: i128| f.to_physical(q, r);
                     let (v, a) = (
                         to(Quantity::Velocity, from.v),
@@ -264,6 +309,15 @@ pub(super) fn plan_part(
                             }
                         }
                     }
+                    // Never faster than the junction allows; on a path, a slower pass (the
+                    // blend point hit with a small change of speed) before a stop there.
+                    let mut found = found.filter(|(v, _)| *v <= junction);
+                    if found.is_none() && path.is_some() {
+                        found = SLOWER.iter().find_map(|&f| {
+                            let v = vb.abs() * f;
+                            blend(v * vb.signum()).ok().map(|r| (v, r))
+                        });
+                    }
                     match found {
                         Some((v, (p, e))) => Ok((
                             p,
@@ -281,11 +335,33 @@ pub(super) fn plan_part(
                         None => buffered(),
                     }
                 }
-                Err(OnlineError::NotRealisable(_)) if vb != 0.0 => buffered(),
                 Err(e) => Err(e),
             }
         }
     }
+}
+
+/// The shares of a blend velocity tried, in turn, when a move on a path can pass its blend
+/// point neither at it (no exact program does) nor faster within its junction's limit.
+const SLOWER: [f64; 8] = [0.995, 0.98, 0.95, 0.9, 0.8, 0.65, 0.5, 0.3];
+
+/// The fastest a move on a path (`path`) passes its end with `next` blending into it: the
+/// smaller element's speed limit and the next one's entry speed (its junction's, lowered by
+/// the look-ahead), or with `hard` its junction's own limit (what a blend that cannot slow to
+/// the entry speed in time may pass at instead); unbounded off a path.
+fn blend_cap(path: Option<OnPath>, next: Option<&MotionCommand>, hard: bool) -> f64 {
+    let next = match next {
+        Some(MotionCommand::MoveAbsolute { path, .. }) => *path,
+        _ => None,
+    };
+    [
+        path.map(|p| p.velocity),
+        next.map(|p| p.velocity),
+        next.map(|p| if hard { p.junction } else { p.entry }),
+    ]
+    .into_iter()
+    .flatten()
+    .fold(f64::INFINITY, f64::min)
 }
 
 /// The output cell of a position (unit).

@@ -64,6 +64,7 @@ fn script(rng: &mut StdRng, f: &Format, n: u8, home: f64) -> Vec<Event> {
                 deceleration: d,
                 jerk: j,
                 buffer_mode: modes[rng.gen_range(0..modes.len())],
+                path: None,
             })
         } else if r < 0.65 {
             let (v, a, d, j) = limits(rng);
@@ -103,6 +104,7 @@ fn script(rng: &mut StdRng, f: &Format, n: u8, home: f64) -> Vec<Event> {
             deceleration: 1000.0,
             jerk: 2e5,
             buffer_mode: BufferMode::Aborting,
+            path: None,
         }),
     });
     events.push(Event {
