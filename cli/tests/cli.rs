@@ -625,3 +625,47 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line 3: M3 is not supported"), "{err}");
 }
+
+/// `snapgen path --scenario seed002`: the line and its tangent arc at the seed's three jerks,
+/// every event taken, the arc entered at speed, the check passed; a G-code part under
+/// overrides too; a malformed override is refused.
+#[test]
+fn path_plays_seed002_as_a_path_and_the_part_under_overrides() {
+    for jerk in ["5000", "50000", "500000"] {
+        let out = snapgen(&["path", "--scenario", "seed002", "--jerk", jerk, "--json"]);
+        assert_ok(&out);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["checked"], true, "{v}");
+        let blocks = v["blocks"].as_array().unwrap();
+        assert_eq!(blocks.len(), 2);
+        let entry = blocks[1]["entry"].as_f64().unwrap();
+        assert!(entry > 100.0 && entry <= 140.0, "{entry}");
+        let events = v["events"].as_array().unwrap();
+        assert_eq!(events.len(), 7);
+        assert!(events
+            .iter()
+            .all(|e| e["tick"].is_u64() && e["refused"].is_null()));
+        // The arc enters once the path has passed 300 mm, after 2 s.
+        assert!(events[5]["tick"].as_u64().unwrap() > 20_000);
+    }
+    let part = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/part.ngc");
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        part,
+        "--override",
+        "1.8@300",
+        "--override",
+        "0.3@2500",
+        "--json",
+    ]);
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["checked"], true, "{v}");
+    assert!(
+        v["blocks"][2]["entry"].as_f64().unwrap() > 0.0,
+        "the tangent arc at speed"
+    );
+    let out = snapgen(&["path", "--gcode", part, "--override", "3@10"]);
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -1,13 +1,16 @@
-//! `snapgen path`: a G-code program of lines, arcs and helices played along its path on the
-//! bit-accurate model (X, Y, Z), each block an exact stop, and checked from the axes'
+//! `snapgen path`: a G-code program of lines, arcs and helices, or seed 002's demonstration
+//! as a path (`--scenario seed002`), played by the axis group on the bit-accurate model (X, Y,
+//! Z): the path length through the PLCopen host axis, tangent blocks joined at speed, corners
+//! stopped exactly, a feed override at given times (`--override K@MS`). Checked from the axes'
 //! positions alone: on the path (lines 1 LSB on every axis, arcs 2) and within every axis's
 //! limits on every tick (`snapgen_host::path`). Prints each block's outcome (`--json`: one
 //! object); `--csv` writes the per-tick trace, `--svg` the path in the XY plane and each axis's
-//! velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read or play.
+//! velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read
+//! or play.
 //!
-//! Not built yet (issue 22): tangent blocks joined at speed, the feed override, corners with
-//! a blend, the N-axis fabric, `--board fabric` and `--port`; the picture does not draw the
-//! measured deviation.
+//! Not built yet (issue 22): corners with a blend, the N-axis fabric, `--board fabric` and
+//! `--port` (the path runs on the host axis's own timeline, each change at the tick it is due);
+//! the picture does not draw the measured deviation.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -15,27 +18,43 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use snapgen_host::gcode::read;
-use snapgen_host::path::{play, verify};
+use snapgen_host::path::{play_events, verify, PathAction, PathEvent, Run};
 use snapgen_model::{Format, FRAC_BITS};
 use snapgen_plan::path::speed::Limits;
 
 use crate::error::InputError;
+use crate::scenario::seed002_path;
 
-/// Play a G-code program along its path on the model.
+/// Play a G-code program (or seed 002's demonstration) along its path on the model.
 #[derive(clap::Args)]
 pub struct Args {
     /// The G-code program.
+    #[arg(
+        long,
+        conflicts_with = "scenario",
+        required_unless_present = "scenario"
+    )]
+    gcode: Option<PathBuf>,
+    /// Seed 002's demonstration as a path: a 400 mm line and a tangent 100 mm arc (R 200 mm)
+    /// entering at 300 mm, the set speed changed as in `snapgen online --scenario seed002`.
+    #[arg(long, value_parser = ["seed002"])]
+    scenario: Option<String>,
+    /// The scenario's path jerk (mm/s³; the seed's 5000, 50000 or 500000).
+    #[arg(long, requires = "scenario", default_value_t = 50_000.0)]
+    jerk: f64,
+    /// A feed override from a time: `K@MS` (K 0–2, MS milliseconds from the start);
+    /// repeat for several.
+    #[arg(long = "override", conflicts_with = "scenario", value_parser = parse_override)]
+    overrides: Vec<(f64, f64)>,
+    /// Each axis's velocity limit (mm/s; also the rapid's speed) [G-code: 50; seed002: 250].
     #[arg(long)]
-    gcode: PathBuf,
-    /// Each axis's velocity limit (mm/s; also the rapid's speed).
-    #[arg(long, default_value_t = 50.0)]
-    vmax: f64,
-    /// Each axis's acceleration limit (mm/s²).
-    #[arg(long, default_value_t = 1000.0)]
-    amax: f64,
-    /// Each axis's jerk limit (mm/s³).
-    #[arg(long, default_value_t = 100_000.0)]
-    jmax: f64,
+    vmax: Option<f64>,
+    /// Each axis's acceleration limit (mm/s²) [G-code: 1000; seed002: 5000].
+    #[arg(long)]
+    amax: Option<f64>,
+    /// Each axis's jerk limit (mm/s³) [G-code: 100000; seed002: 2000000].
+    #[arg(long)]
+    jmax: Option<f64>,
     /// The tick (s).
     #[arg(long, default_value_t = 1e-4)]
     ts: f64,
@@ -60,36 +79,92 @@ pub struct Args {
 #[error("the played path failed its check")]
 pub struct CheckFailed;
 
+/// `K@MS` as (K, MS).
+fn parse_override(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("{s}: give K@MS, a factor 0–2 and a time in ms (e.g. 0.5@1200)");
+    let (k, ms) = s.split_once('@').ok_or_else(bad)?;
+    let (k, ms): (f64, f64) = (
+        k.trim().parse().map_err(|_| bad())?,
+        ms.trim().parse().map_err(|_| bad())?,
+    );
+    if !((0.0..=2.0).contains(&k) && ms.is_finite() && ms >= 0.0) {
+        return Err(bad());
+    }
+    Ok((k, ms))
+}
+
 /// Runs the subcommand.
 pub fn run(a: Args) -> anyhow::Result<()> {
+    let scenario = a.scenario.is_some();
+    let default = if scenario {
+        seed002_path::AXES
+    } else {
+        Limits {
+            velocity: 50.0,
+            acceleration: 1000.0,
+            jerk: 100_000.0,
+        }
+    };
+    let axis = Limits {
+        velocity: a.vmax.unwrap_or(default.velocity),
+        acceleration: a.amax.unwrap_or(default.acceleration),
+        jerk: a.jmax.unwrap_or(default.jerk),
+    };
     for (flag, v) in [
-        ("--vmax", a.vmax),
-        ("--amax", a.amax),
-        ("--jmax", a.jmax),
+        ("--vmax", axis.velocity),
+        ("--amax", axis.acceleration),
+        ("--jmax", axis.jerk),
         ("--ts", a.ts),
         ("--lsb", a.lsb),
+        ("--jerk", a.jerk),
     ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(InputError::Board(format!("{flag} {v}: give a positive number")).into());
         }
     }
-    let src = std::fs::read_to_string(&a.gcode)
-        .with_context(|| format!("cannot read {}", a.gcode.display()))?;
-    let blocks =
-        read(&src, a.lsb).map_err(|e| InputError::Board(format!("{}: {e}", a.gcode.display())))?;
     let format = Format {
         ts: a.ts,
         position_lsb: a.lsb,
         ..snapgen_model::DEFAULT_FORMAT
     };
-    let axis = Limits {
-        velocity: a.vmax,
-        acceleration: a.amax,
-        jerk: a.jmax,
-    };
     let axes = [axis; 3];
-    let run = play(&blocks, &axes, &format)
-        .map_err(|e| InputError::Board(format!("{}: {e}", a.gcode.display())))?;
+    let (name, blocks, own, events) = match &a.gcode {
+        Some(file) => {
+            let src = std::fs::read_to_string(file)
+                .with_context(|| format!("cannot read {}", file.display()))?;
+            let blocks = read(&src, a.lsb)
+                .map_err(|e| InputError::Board(format!("{}: {e}", file.display())))?;
+            let mut events: Vec<PathEvent> = a
+                .overrides
+                .iter()
+                .map(|&(k, at_ms)| PathEvent {
+                    at_ms,
+                    at_length: None,
+                    action: PathAction::Override(k),
+                })
+                .collect();
+            if let Some(last) = blocks.len().checked_sub(1) {
+                events.push(PathEvent {
+                    at_ms: 0.0,
+                    at_length: None,
+                    action: PathAction::Enter(last),
+                });
+            }
+            events.sort_by(|x, y| x.at_ms.total_cmp(&y.at_ms));
+            (file.display().to_string(), blocks, None, events)
+        }
+        None => (
+            format!(
+                "seed 002 as a path: 400 mm line, tangent 100 mm arc (R 200 mm) entering at 300 mm, jerk {} mm/s³",
+                a.jerk
+            ),
+            seed002_path::blocks(a.lsb),
+            Some(seed002_path::limits(a.jerk)),
+            seed002_path::events(),
+        ),
+    };
+    let run = play_events(&blocks, &axes, own, &format, &events)
+        .map_err(|e| InputError::Board(format!("{name}: {e}")))?;
     let ticks = run.trace.len() as u64 - 1;
     if let Some(path) = &a.csv {
         write_csv(&run.trace, &format, path)
@@ -97,8 +172,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &a.svg {
-        let title = format!("{}", a.gcode.display());
-        crate::svg::write_path_svg(&run.trace, &format, &title, path)
+        crate::svg::write_path_svg(&run.trace, &format, &name, path)
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
@@ -116,6 +190,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     "velocity": b.limits.velocity,
                     "acceleration": b.limits.acceleration,
                     "jerk": b.limits.jerk,
+                    "entry": b.entry,
+                    "outcome": b.outcome.name(),
                     "ticks": b.ticks,
                 })
             })
@@ -129,6 +205,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             .collect();
         let v = serde_json::json!({
             "blocks": blocks,
+            "events": events_json(&events, &run),
             "ticks": ticks,
             "duration_s": ticks as f64 * a.ts,
             "peaks": peaks,
@@ -138,18 +215,26 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         });
         println!("{v}");
     } else {
-        println!("line  kind    length mm   v mm/s   a mm/s²   j mm/s³     ticks");
+        println!("{name}");
+        println!(
+            "line  kind    length mm   v mm/s   a mm/s²   j mm/s³  entry mm/s     ticks  outcome"
+        );
         for b in &run.blocks {
             println!(
-                "{:>4}  {:<6} {:>10.4} {:>8.3} {:>9.1} {:>9.0} {:>9}",
+                "{:>4}  {:<6} {:>10.4} {:>8.3} {:>9.1} {:>9.0} {:>11.3} {:>9}  {}",
                 b.line,
                 b.kind,
                 b.length,
                 b.limits.velocity,
                 b.limits.acceleration,
                 b.limits.jerk,
-                b.ticks
+                b.entry,
+                b.ticks,
+                b.outcome.name()
             );
+        }
+        for e in events_json(&events, &run) {
+            println!("  event {e}");
         }
         println!(
             "{} blocks, {ticks} ticks ({:.3} s)",
@@ -174,6 +259,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         Err(CheckFailed.into())
     }
+}
+
+/// Each event: what, when it was due, the tick it was taken on, a refusal.
+fn events_json(events: &[PathEvent], run: &Run) -> Vec<serde_json::Value> {
+    events
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let what = match e.action {
+                PathAction::Enter(k) => format!("block {} enters", k + 1),
+                PathAction::Override(k) => format!("override {:.0} %", k * 100.0),
+            };
+            serde_json::json!({
+                "event": what,
+                "at_ms": e.at_ms,
+                "at_length_mm": e.at_length,
+                "tick": run.taken.get(i).copied().flatten(),
+                "refused": run.refused.iter().find(|(k, _)| *k == i).map(|(_, r)| r.to_string()),
+            })
+        })
+        .collect()
 }
 
 fn write_csv(trace: &[Vec<i128>], f: &Format, path: &PathBuf) -> std::io::Result<()> {

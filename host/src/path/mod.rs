@@ -1,21 +1,24 @@
-//! A G-code program played along its path on the bit-accurate model, and checked.
+//! A path (a G-code program's blocks) played by the axis group on the bit-accurate model, and
+//! checked.
 //!
-//! Each block is an element planned from rest to rest on its length (an exact stop at every
-//! block end, PLCopen Buffered: tangent blocks joined at speed are not built yet) with the
-//! limits the element allows (`snapgen_plan::path::speed`: the block's feed, or for a rapid
-//! the axes' own limits, and whatever the geometry takes from each axis). The chain plays the
-//! plan tick by tick and the interpolator's rules map it onto the axes. The whole trace is
-//! then held, from the positions alone, against the path as programmed and each axis's limits
-//! (`snapgen_verify::path`): lines within 1 LSB on every axis, arcs within 2.
+//! [`group`] plays the path length `s` through the PLCopen host axis, each block a move on it
+//! with the limits the element allows (`snapgen_plan::path::speed`: the block's feed, or for a
+//! rapid the axes' own limits, and whatever the geometry takes from each axis); tangent blocks
+//! join at the speed their junction allows, corners stop exactly. The interpolator's rules map
+//! `s` onto the axes on every tick. The whole trace is then held, from the positions alone,
+//! against the path as programmed and each axis's limits (`snapgen_verify::path`): lines within
+//! 1 LSB on every axis, arcs within 2.
 
-use snapgen_model::chain::Trace;
+pub mod group;
+
 use snapgen_model::{Format, Quantity, FRAC_BITS};
-use snapgen_plan::path::speed::{element_limits, Limits};
-use snapgen_plan::path::{prepare, Element, PathError};
-use snapgen_plan::{plan, Method, MoveRequest, PlanError};
+use snapgen_plan::path::speed::Limits;
+use snapgen_plan::path::{Element, PathError};
 use snapgen_verify::path as check;
 
+use crate::axis::{AxisErrorId, Outcome};
 use crate::gcode::Block;
+pub use group::{Group, PathAction, PathEvent, PathLimits};
 
 /// What went wrong with a block.
 #[derive(Debug, thiserror::Error)]
@@ -34,13 +37,13 @@ pub enum PlayError {
         /// Its line.
         line: usize,
     },
-    /// The planner refused the block.
+    /// The block's move ended in Error.
     #[error("line {line}: {source}")]
-    Plan {
+    Move {
         /// Its line.
         line: usize,
         /// Why.
-        source: PlanError,
+        source: AxisErrorId,
     },
 }
 
@@ -53,9 +56,16 @@ pub struct Played {
     pub kind: &'static str,
     /// Its length (mm).
     pub length: f64,
-    /// The limits its path length was planned with.
+    /// The limits its path length was planned with (its feed, its geometry).
     pub limits: Limits,
-    /// Ticks it took.
+    /// The speed its start was allowed to be passed at (0: from rest, a corner).
+    pub entry: f64,
+    /// Played in one move with the element before it (a short element joined at speed: its
+    /// move has the smaller limits of the two).
+    pub joined: bool,
+    /// Its move's outcome (`Done`, or how it ended).
+    pub outcome: Outcome,
+    /// Ticks the path length spent on it.
     pub ticks: u64,
 }
 
@@ -63,10 +73,16 @@ pub struct Played {
 /// start, at rest).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Run {
-    /// The blocks.
+    /// The blocks that entered the buffer.
     pub blocks: Vec<Played>,
     /// Every axis on every tick (raw, the chain's format).
     pub trace: Vec<Vec<i128>>,
+    /// The path length on every tick (raw `s`, from the start's cell centre).
+    pub lengths: Vec<i128>,
+    /// The tick each event was taken on (None: its length was never reached).
+    pub taken: Vec<Option<u64>>,
+    /// Overrides refused (event index, why).
+    pub refused: Vec<(usize, AxisErrorId)>,
 }
 
 /// What the independent check found.
@@ -81,70 +97,80 @@ pub struct Checked {
 }
 
 /// Plays `blocks` from the origin with `axes` (X, Y, Z) limits in `format` (mm, its LSB and
-/// Ts).
-pub fn play(blocks: &[Block], axes: &[Limits; 3], format: &Format) -> Result<Run, PlayError> {
-    // Every block prepared first: a block that cannot be is refused before anything moves.
-    let mut at = vec![0i64; 3];
-    let mut prepared_all = Vec::new();
-    for b in blocks {
-        let prepared =
-            prepare(&at, std::slice::from_ref(&b.element)).map_err(|source| PlayError::Path {
-                line: b.line,
-                source,
-            })?;
-        prepared_all.push(prepared);
-        at = match &b.element {
-            Element::Line { to } | Element::Arc { to, .. } => to.clone(),
-        };
+/// Ts): every block enters the buffer at once, tangent blocks join at speed, corners stop.
+pub fn play(blocks: &[Block], axes: &[Limits], format: &Format) -> Result<Run, PlayError> {
+    let events = match blocks.len() {
+        0 => vec![],
+        n => vec![PathEvent {
+            at_ms: 0.0,
+            at_length: None,
+            action: PathAction::Enter(n - 1),
+        }],
+    };
+    play_events(blocks, axes, None, format, &events)
+}
+
+/// Plays `blocks` as `events` let them enter, with the path's `own` limits (when given)
+/// beside each axis's.
+pub fn play_events(
+    blocks: &[Block],
+    axes: &[Limits],
+    own: Option<PathLimits>,
+    format: &Format,
+    events: &[PathEvent],
+) -> Result<Run, PlayError> {
+    let mut g = Group::new(blocks, axes, own, format)?;
+    g.play(events);
+    let lengths = g.lengths();
+    // Ticks on each element: those whose `s` lies within its share.
+    let mut on = vec![0u64; g.bounds().len()];
+    for s in &lengths {
+        let r = s - group::s0();
+        let k = g.bounds().partition_point(|&b| b <= r);
+        if let Some(n) = on.get_mut(k) {
+            *n += 1;
+        }
     }
-    let mut trace: Vec<Vec<i128>> = vec![vec![snapgen_plan::path::raw(0); 3]];
     let mut played = Vec::new();
-    for (b, prepared) in blocks.iter().zip(&prepared_all) {
-        let line = b.line;
-        let g = prepared.geometries()[0].scaled(format.position_lsb);
-        let limits = element_limits(&g, axes, b.feed.unwrap_or(f64::INFINITY))
-            .ok_or(PlayError::Still { line })?;
-        let p = plan(
-            &MoveRequest {
-                distance: prepared.length_physical(format.position_lsb),
-                method: Method::Order3 {
-                    vmax: limits.velocity,
-                    amax: limits.acceleration,
-                    jmax: limits.jerk,
-                },
-            },
-            format,
-        )
-        .map_err(|source| PlayError::Plan { line, source })?;
-        let path = prepared.fit(p.final_state.x - p.start.x);
-        trace.extend(
-            Trace::new(&p.program, p.start, format.widths)
-                .skip(1)
-                .map(|t| path.at(t.state.x - p.start.x).expect("one element")),
-        );
+    for (k, (&entry, &c)) in g.entries().iter().zip(g.commands()).enumerate() {
+        let b = &blocks[k];
+        let rec = &g.axis.commands[c];
+        if let Outcome::Error(e) = &rec.outcome {
+            return Err(PlayError::Move {
+                line: b.line,
+                source: e.clone(),
+            });
+        }
+        let p = &g.planned()[k];
         played.push(Played {
-            line,
+            line: b.line,
             kind: match (&b.element, b.feed) {
                 (_, None) => "rapid",
                 (Element::Line { .. }, _) => "line",
                 (Element::Arc { .. }, _) => "arc",
             },
-            length: prepared.length_physical(format.position_lsb),
-            limits,
-            ticks: p.ticks_total(),
+            length: p.length,
+            limits: p.limits,
+            entry,
+            joined: k > 0 && g.commands().get(k - 1) == Some(&c),
+            outcome: rec.outcome.clone(),
+            ticks: on[k],
         });
     }
     Ok(Run {
         blocks: played,
-        trace,
+        trace: g.trace(),
+        lengths,
+        taken: g.taken.clone(),
+        refused: g.refused.clone(),
     })
 }
 
 /// Holds `run` against the path of `blocks` and the `axes`' limits (module documentation).
-pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits; 3], format: &Format) -> Checked {
-    let mut at = vec![0i128; 3];
+pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits], format: &Format) -> Checked {
+    let mut at = vec![0i128; axes.len()];
     let mut path = Vec::new();
-    for b in blocks {
+    for b in &blocks[..run.blocks.len()] {
         let to: Vec<i128> = match &b.element {
             Element::Line { to } | Element::Arc { to, .. } => {
                 to.iter().map(|&x| x.into()).collect()
@@ -239,6 +265,15 @@ mod tests {
         assert_eq!(run.blocks.len(), 5);
         assert_eq!(run.blocks[0].kind, "rapid");
         assert!(run.blocks[1].limits.velocity <= 20.0, "F1200 = 20 mm/s");
+        // G1 X20 runs into the tangent G3 at speed; the G2 after it meets it at a corner,
+        // and so does the G1 after the G2.
+        let entries: Vec<f64> = run.blocks.iter().map(|b| b.entry).collect();
+        // R = 5 mm: v²/(R·Ts) within half the jerk, √(0.49·1e5·1e-4·5) = 4.95 mm/s.
+        assert!((entries[2] - 4.9497).abs() < 1e-3, "{entries:?}");
+        assert_eq!(
+            (entries[0], entries[1], entries[3], entries[4]),
+            (0.0, 0.0, 0.0, 0.0)
+        );
         let c = verify(&run, &blocks, &[AXIS; 3], &F);
         assert_eq!((c.deviation, c.exceeded), (None, None));
         // The end: (5, 5, -1) mm exactly.

@@ -126,14 +126,22 @@ impl Path {
     }
 
     /// Every axis at path length `s`: the segment `s` lies in (a segment's end belongs to it
-    /// only at the path's end: elsewhere the next one starts there); `s` below 0 is the start,
-    /// beyond the length the end. None for a path without segments.
+    /// only at the path's end: elsewhere the next one starts there); `s` below 0 is the start.
+    /// Beyond the length the last segment's rule goes on for up to one output cell (a chain
+    /// brought to rest on a position ends within that cell's width of it, on either side: the
+    /// axes run on smoothly, then stop, rather than stopping while `s` still moves), then
+    /// stays. None for a path without segments.
     pub fn at(&self, s: i128) -> Option<Vec<i128>> {
         let mut start = 0i128;
         let last = self.segments.len().checked_sub(1)?;
         for (k, g) in self.segments.iter().enumerate() {
             if s < start + g.length || k == last {
-                return Some(g.at((s - start).clamp(0, g.length)));
+                let beyond = if k == last {
+                    1i128 << crate::FRAC_BITS
+                } else {
+                    0
+                };
+                return Some(g.at((s - start).clamp(0, g.length + beyond)));
             }
             start += g.length;
         }
@@ -216,7 +224,12 @@ mod tests {
         assert_eq!(p.at(9), Some(vec![9]));
         assert_eq!(p.at(10), Some(vec![100]), "the next segment's start");
         assert_eq!(p.at(15), Some(vec![105]));
-        assert_eq!(p.at(99), Some(vec![105]), "beyond the end: the end");
+        let cell = 1i128 << crate::FRAC_BITS;
+        assert_eq!(
+            p.at(15 + cell + 99),
+            Some(vec![105 + cell]),
+            "beyond the end: on for a cell"
+        );
         assert_eq!(p.at(-3), Some(vec![0]));
         assert_eq!(Path { segments: vec![] }.at(0), None);
     }

@@ -15,9 +15,11 @@
 //!   start's to the end point's along it (the two may differ by at most 1 LSB: an end point
 //!   rounded to the grid is rarely exactly on the circle).
 //! * [`speed`]: the limits each element allows `s` so that no axis exceeds its own.
-//! * Not built yet: tangent extension online and corners at speed (every element is planned
-//!   from rest to rest), the sequencer in the fabric (issue 22).
+//! * [`junction`]: the speed a junction of two tangent elements may be passed at, and the
+//!   look-ahead; corners stop exactly.
+//! * Not built yet: blends at corners, the sequencer in the fabric (issue 22).
 
+pub mod junction;
 pub mod speed;
 
 use ethnum::I256;
