@@ -209,6 +209,7 @@ pub fn write_loop_svg(
 /// positions (per-bucket minima and maxima, so one-tick spikes stay visible).
 pub fn write_path_svg(
     trace: &[Vec<i128>],
+    distance: &[f64],
     format: &Format,
     title: &str,
     path: &Path,
@@ -248,11 +249,12 @@ pub fn write_path_svg(
             }
         }
     }
-    let root = SVGBackend::new(path, (1000, 1400)).into_drawing_area();
+    let root = SVGBackend::new(path, (1000, 1720)).into_drawing_area();
     root.fill(&WHITE)?;
     let (head, body) = root.split_vertically(40);
     head.titled(title, ("sans-serif", 20))?;
     let (top, rest) = body.split_vertically(500);
+    let (rest, bottom) = rest.split_vertically(900);
     // The path in the XY plane.
     let step = (trace.len() / 20_000).max(1);
     let xy: Vec<(f64, f64)> = trace
@@ -296,6 +298,22 @@ pub fn write_path_svg(
             chart.draw_series(LineSeries::new(s.iter().map(|b| (b.0, b.1)), color))?;
         }
     }
+    // The distance from the programmed path, per bucket of ticks its largest.
+    let mut far: Vec<(f64, f64)> = Vec::new();
+    for (k, &d) in distance.iter().enumerate() {
+        let t = k as f64 * format.ts;
+        match far.last_mut() {
+            Some(b) if (b.0 / format.ts) as u64 / per == k as u64 / per => b.1 = b.1.max(d),
+            _ => far.push((t, d)),
+        }
+    }
+    let top_d = far.iter().map(|b| b.1).fold(0.0f64, f64::max).max(1e-6) * 1.1;
+    let caption = format!(
+        "distance from the programmed path (LSB; largest {:.3e}; the check allows 1 on a line's axes, 2 from an arc)",
+        distance.iter().copied().fold(0.0f64, f64::max)
+    );
+    let mut chart = time_panel(&bottom, &caption, t_end, (0.0, top_d))?;
+    chart.draw_series(LineSeries::new(far, &BLACK))?;
     root.present()?;
     Ok(())
 }

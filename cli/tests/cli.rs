@@ -601,6 +601,8 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
     );
     let picture = std::fs::read_to_string(&svg).unwrap();
     assert!(picture.contains("path, XY plane") && picture.contains("jerk (mm/s^3)"));
+    assert!(picture.contains("distance from the programmed path"));
+    assert!(text.contains("farthest from the programmed path"), "{text}");
     let rows = std::fs::read_to_string(&csv).unwrap();
     let last = rows.lines().last().unwrap();
     let xyz: Vec<f64> = last
@@ -624,18 +626,40 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line 3: M3 is not supported"), "{err}");
+    // A path longer than its length register holds (1073.7 mm at 1 nm), with its block.
+    let long = tmp("long.ngc");
+    std::fs::write(&long, "G21 F6000\nG1 X600\nG1 X1200\nM30\n").unwrap();
+    let out = snapgen(&["path", "--gcode", long.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 3: the path reaches 1200.000"), "{err}");
 }
 
 /// `snapgen path --scenario seed002`: the line and its tangent arc at the seed's three jerks,
-/// every event taken, the arc entered at speed, the check passed; a G-code part under
-/// overrides too; a malformed override is refused.
+/// every event taken, the arc entered at speed, the check passed, the durations docs/PATH.md
+/// gives; the arc enters on the first tick the trace (`--csv`) is 300 mm along; a G-code part
+/// under overrides too; a malformed override is refused.
 #[test]
 fn path_plays_seed002_as_a_path_and_the_part_under_overrides() {
-    for jerk in ["5000", "50000", "500000"] {
-        let out = snapgen(&["path", "--scenario", "seed002", "--jerk", jerk, "--json"]);
+    let csv = tmp("seed002_path.csv");
+    for (jerk, duration) in [("5000", 4.9177), ("50000", 4.7611), ("500000", 4.7042)] {
+        let out = snapgen(&[
+            "path",
+            "--scenario",
+            "seed002",
+            "--jerk",
+            jerk,
+            "--json",
+            "--csv",
+            csv.to_str().unwrap(),
+        ]);
         assert_ok(&out);
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(v["checked"], true, "{v}");
+        assert!(
+            (v["duration_s"].as_f64().unwrap() - duration).abs() < 1e-9,
+            "{v}"
+        );
         let blocks = v["blocks"].as_array().unwrap();
         assert_eq!(blocks.len(), 2);
         let entry = blocks[1]["entry"].as_f64().unwrap();
@@ -645,8 +669,15 @@ fn path_plays_seed002_as_a_path_and_the_part_under_overrides() {
         assert!(events
             .iter()
             .all(|e| e["tick"].is_u64() && e["refused"].is_null()));
-        // The arc enters once the path has passed 300 mm, after 2 s.
-        assert!(events[5]["tick"].as_u64().unwrap() > 20_000);
+        // The arc enters on the first tick X (the path length, on the line) is 300 mm along.
+        let rows = std::fs::read_to_string(&csv).unwrap();
+        let reached = rows
+            .lines()
+            .skip(1)
+            .map(|r| r.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+            .position(|x| x >= 300.0 - 0.5e-6)
+            .unwrap();
+        assert_eq!(events[5]["tick"].as_u64(), Some(reached as u64), "{jerk}");
     }
     let part = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/part.ngc");
     let out = snapgen(&[
@@ -667,5 +698,54 @@ fn path_plays_seed002_as_a_path_and_the_part_under_overrides() {
         "the tangent arc at speed"
     );
     let out = snapgen(&["path", "--gcode", part, "--override", "3@10"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// `snapgen path --board model`: a line, a tangent arc and a line with the path length
+/// integrated by the virtual board (its Ts read from it: 10 µs), the host interpolating: the
+/// check passes, the tangent arc is entered at speed, and the end is the program's; `--ts`
+/// with a board is refused.
+#[test]
+fn path_runs_its_length_on_a_virtual_board() {
+    let small = tmp("small.ngc");
+    std::fs::write(&small, "G21 G90 F1200\nG1 X2\nG3 X4 Y2 J2\nG1 Y3\nM30\n").unwrap();
+    let csv = tmp("small.csv");
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        small.to_str().unwrap(),
+        "--board",
+        "model",
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["checked"], true, "{v}");
+    assert_eq!(v["ts"].as_f64(), Some(1e-5));
+    assert!(v["blocks"][1]["entry"].as_f64().unwrap() > 0.5, "{v}");
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    let last: Vec<f64> = rows
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .skip(2)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!(
+        (last[0] - 4.0).abs() < 1e-6 && (last[1] - 3.0).abs() < 1e-6,
+        "{last:?}"
+    );
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        small.to_str().unwrap(),
+        "--board",
+        "model",
+        "--ts",
+        "1e-4",
+    ]);
     assert_eq!(out.status.code(), Some(2));
 }

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{ensure, Context};
 use serde::{Deserialize, Serialize};
-use snapgen_host::axis::{Goal, Outcome};
+use snapgen_host::axis::{Goal, MotionCommand, Outcome};
 use snapgen_host::driver::{Action, Event, RunOptions, RunReport};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::{play as play_script, PlayError, PlayOptions};
@@ -169,6 +169,14 @@ impl Script {
                 e.at_ms
             );
             last = e.at_ms;
+            let on_path = matches!(
+                e.action,
+                Action::Command(MotionCommand::MoveAbsolute { path: Some(_), .. })
+            );
+            ensure!(
+                !on_path,
+                "event {k}: `path` (an element's caps) is set by `snapgen path`, not by a script: remove it"
+            );
         }
         Ok(())
     }

@@ -17,12 +17,21 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 use anyhow::Context;
-use snapgen_host::gcode::read;
-use snapgen_host::path::{play_events, verify, PathAction, PathEvent, Run};
+use snapgen_host::driver::RunOptions;
+use snapgen_host::gcode::{read, Block};
+use snapgen_host::link::{FramedLink, Link, RetryPolicy};
+use snapgen_host::online::PlayError as ScriptError;
+use snapgen_host::path::board::{play_on_board, BoardError};
+use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
+use snapgen_host::serial::{session_seq, SerialTransport};
+use snapgen_host::session::Session;
 use snapgen_model::{Format, FRAC_BITS};
 use snapgen_plan::path::speed::Limits;
+use snapgen_sim::board::VirtualBoard;
+use snapgen_sim::host_link::board_link;
 
-use crate::error::InputError;
+use crate::commands::online::BoardKind;
+use crate::error::{failure, InputError};
 use crate::scenario::seed002_path;
 
 /// Play a G-code program (or seed 002's demonstration) along its path on the model.
@@ -55,9 +64,21 @@ pub struct Args {
     /// Each axis's jerk limit (mm/s³) [G-code: 100000; seed002: 2000000].
     #[arg(long)]
     jmax: Option<f64>,
-    /// The tick (s).
-    #[arg(long, default_value_t = 1e-4)]
-    ts: f64,
+    /// The tick (s) [1e-4; on a board, the board's, read from it].
+    #[arg(long)]
+    ts: Option<f64>,
+    /// Run the path length on a virtual board: the device model, or the Verilated I/O top
+    /// with the device model in lockstep (every output compared on every clock); the
+    /// interpolator stays on the host. Without it (or `--port`) the host axis plays its own
+    /// timeline, each change at the tick it is due.
+    #[arg(long, value_enum, conflicts_with = "port")]
+    board: Option<BoardKind>,
+    /// A real board's serial port instead.
+    #[arg(long)]
+    port: Option<String>,
+    /// Baud rate: the virtual board's UART (its design) or the port's.
+    #[arg(long, default_value_t = 115_200)]
+    baud: u32,
     /// The output grid (mm per LSB).
     #[arg(long, default_value_t = 1e-6)]
     lsb: f64,
@@ -114,7 +135,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("--vmax", axis.velocity),
         ("--amax", axis.acceleration),
         ("--jmax", axis.jerk),
-        ("--ts", a.ts),
+        ("--ts", a.ts.unwrap_or(1e-4)),
         ("--lsb", a.lsb),
         ("--jerk", a.jerk),
     ] {
@@ -122,8 +143,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             return Err(InputError::Board(format!("{flag} {v}: give a positive number")).into());
         }
     }
+    let on_board = a.board.is_some() || a.port.is_some();
+    if on_board && a.ts.is_some() {
+        return Err(InputError::Board(
+            "--ts: a board's tick is read from the board; leave --ts out".into(),
+        )
+        .into());
+    }
     let format = Format {
-        ts: a.ts,
+        ts: a.ts.unwrap_or(1e-4),
         position_lsb: a.lsb,
         ..snapgen_model::DEFAULT_FORMAT
     };
@@ -163,20 +191,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             seed002_path::events(),
         ),
     };
-    let run = play_events(&blocks, &axes, own, &format, &events)
-        .map_err(|e| InputError::Board(format!("{name}: {e}")))?;
+    let (run, format, mismatches) = if on_board {
+        board_run(&a, &blocks, &axes, own, &events)
+            .map_err(|e| e.context(format!("{name} on the board")))?
+    } else {
+        let run = play_events(&blocks, &axes, own, &format, &events)
+            .map_err(|e| InputError::Board(format!("{name}: {e}")))?;
+        (run, format, None)
+    };
     let ticks = run.trace.len() as u64 - 1;
     if let Some(path) = &a.csv {
         write_csv(&run.trace, &format, path)
             .with_context(|| format!("cannot write {}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
+    let c = verify(&run, &blocks, &axes, &format);
     if let Some(path) = &a.svg {
-        crate::svg::write_path_svg(&run.trace, &format, &name, path)
+        crate::svg::write_path_svg(&run.trace, &c.distance, &format, &name, path)
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
-    let c = verify(&run, &blocks, &axes, &format);
+    let farthest = c.distance.iter().copied().fold(0.0f64, f64::max);
     let passed = c.deviation.is_none() && c.exceeded.is_none();
     if a.json {
         let blocks: Vec<serde_json::Value> = run
@@ -206,8 +241,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let v = serde_json::json!({
             "blocks": blocks,
             "events": events_json(&events, &run),
+            "ts": format.ts,
+            "max_distance_lsb": farthest,
+            "mismatches": mismatches,
             "ticks": ticks,
-            "duration_s": ticks as f64 * a.ts,
+            "duration_s": ticks as f64 * format.ts,
             "peaks": peaks,
             "checked": passed,
             "deviation": c.deviation.as_ref().map(|d| format!("{d:?}")),
@@ -239,8 +277,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         println!(
             "{} blocks, {ticks} ticks ({:.3} s)",
             run.blocks.len(),
-            ticks as f64 * a.ts
+            ticks as f64 * format.ts
         );
+        println!("farthest from the programmed path: {farthest:.3e} LSB");
         for (name, [v, aa, j]) in ["X", "Y", "Z"].iter().zip(&c.peaks) {
             println!("{name}: peaks {v:.3} mm/s, {aa:.1} mm/s², {j:.0} mm/s³");
         }
@@ -252,6 +291,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         if let Some(e) = &c.exceeded {
             println!("OVER A LIMIT: {e:?}");
+        }
+    }
+    if let Some(m) = mismatches {
+        if !a.json {
+            println!("fabric against the model: {m} clocks differed");
+        }
+        if m > 0 {
+            return Err(anyhow::Error::new(crate::error::Mismatched));
         }
     }
     if passed {
@@ -280,6 +327,65 @@ fn events_json(events: &[PathEvent], run: &Run) -> Vec<serde_json::Value> {
             })
         })
         .collect()
+}
+
+/// The path run on a board (`--board`, `--port`): the run, the board's format, and for the
+/// Verilated fabric the clocks on which it differed from the model.
+fn board_run(
+    a: &Args,
+    blocks: &[Block],
+    axes: &[Limits],
+    own: Option<PathLimits>,
+    events: &[PathEvent],
+) -> anyhow::Result<(Run, Format, Option<u64>)> {
+    if let Some(port) = &a.port {
+        let t = SerialTransport::open(port, a.baud)?;
+        let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
+        let (run, format, _) = session_run(link, a.lsb, blocks, axes, own, events)?;
+        return Ok((run, format, None));
+    }
+    let design = crate::commands::online::design(a.baud)?;
+    let fabric = a.board == Some(BoardKind::Fabric);
+    let board = if fabric {
+        VirtualBoard::lockstep(&design)?
+    } else {
+        VirtualBoard::model(&design)
+    };
+    let (run, format, link) = session_run(board_link(board), a.lsb, blocks, axes, own, events)?;
+    let b = link.transport().board();
+    if let Some(m) = b.first_mismatch() {
+        eprintln!("first mismatch: {m:?}");
+    }
+    Ok((run, format, fabric.then(|| b.mismatches())))
+}
+
+/// A session on `link` (the board's format read, the axis at rest), the path played on it.
+fn session_run<L: Link>(
+    link: L,
+    lsb: f64,
+    blocks: &[Block],
+    axes: &[Limits],
+    own: Option<PathLimits>,
+    events: &[PathEvent],
+) -> anyhow::Result<(Run, Format, L)> {
+    let mut session = Session::open(link, lsb).map_err(failure)?;
+    let (run, _, warnings) = play_on_board(
+        &mut session,
+        blocks,
+        axes,
+        own,
+        events,
+        RunOptions::default(),
+    )
+    .map_err(|e| match e {
+        BoardError::Path(p) => InputError::Board(p.to_string()).into(),
+        BoardError::Board(ScriptError::Setup(f)) => failure(f),
+        e => anyhow::Error::new(e),
+    })?;
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok((run, session.format, session.link))
 }
 
 fn write_csv(trace: &[Vec<i128>], f: &Format, path: &PathBuf) -> std::io::Result<()> {

@@ -4,7 +4,7 @@
 use snapgen_model::format::Quantity;
 use snapgen_plan::online::OnlineError;
 
-use super::part::{check_inputs, plan_part, prefix, STOPPED_ON_TARGET};
+use super::part::{check_inputs, plan_part, prefix, PASSED_ON, STOPPED_ON_TARGET};
 use super::{
     AxisErrorId, BufferMode, Change, Goal, HostAxis, MotionCommand, Outcome, Part, Timeline,
 };
@@ -76,44 +76,37 @@ impl HostAxis {
         if let Request::Override(k) = req {
             return self.plan_override(at, k);
         }
-        // The move playing at `at`, replanned to blend, turning back (its target too near to
-        // pass at the blend, and a replan to rest from where it is overshooting): it plays on
-        // unchanged instead, as when it cannot be replanned at all.
-        let playing = self
-            .timeline
-            .parts
-            .iter()
-            .find(|p| p.end_tick() > at)
-            .map(|p| p.command);
-        match self.plan_change_with(at, req, true, false) {
-            Ok(c)
-                if self.blends(req)
-                    && playing.is_some_and(|p| self.turns_back(&c, p, at))
-                    && self.plan_change_with(at, req, false, false).is_ok() =>
-            {
-                let mut c = self.plan_change_with(at, req, false, false)?;
-                if let Request::Command(k) = req {
-                    c.notes.push((
-                        k,
-                        "the previous move would have turned back to blend from where it was: buffered instead"
-                            .into(),
-                    ));
-                }
-                Ok(c)
-            }
-            Err(_) if self.blends(req) => {
-                let mut c = self.plan_change_with(at, req, false, false)?;
-                if let Request::Command(k) = req {
-                    c.notes.push((
-                        k,
-                        "the previous move could not be replanned to blend from where it was: buffered instead"
-                            .into(),
-                    ));
-                }
-                Ok(c)
+        // The move a blend replans (the last one) overshooting its target and coming back
+        // from `at` (its target too near to pass at the blend, and a replan to rest from where
+        // it is running past it), or turning back where its plan did not: it plays on
+        // unchanged instead, as when it cannot be replanned.
+        let previous = self.timeline.parts.last().map(|p| p.command);
+        let blended = self.plan_change_with(at, req, true, false);
+        let overshoots = blended.as_ref().is_ok_and(|c| {
+            previous.is_some_and(|p| {
+                self.overshoots(c, p, at)
+                    || (self.reverses(&c.timeline, p, at) && !self.reverses(&self.timeline, p, at))
+            })
+        });
+        match blended {
+            Err(_) if self.blends(req) => self.buffered(at, req, "could not be replanned"),
+            Ok(_) if overshoots && self.blends(req) => {
+                self.buffered(at, req, "would have overshot its target")
             }
             r => r,
         }
+    }
+
+    /// `req` planned without its blend (the previous move unchanged), noted with `why`.
+    fn buffered(&self, at: u64, req: Request, why: &str) -> Result<Change, Refusal> {
+        let mut c = self.plan_change_with(at, req, false, false)?;
+        if let Request::Command(k) = req {
+            c.notes.push((
+                k,
+                format!("the previous move {why} to blend from where it was: buffered instead"),
+            ));
+        }
+        Ok(c)
     }
 
     /// An override to factor `k` from tick `at`: the parts from `at` replanned with it, unless
@@ -128,6 +121,39 @@ impl HostAxis {
         let Some(p) = self.timeline.parts.iter().find(|p| p.end_tick() > at) else {
             return replanned;
         };
+        // A change the move playing at `at` cannot follow without overshooting its target and
+        // coming back (too near to slow to the new speed, to the blend it asks, or to rest, in
+        // time): that move plays on as planned, the override acts from the next one.
+        // (Or a replan that turns back where the plan did not: the planner's realisation of a
+        // stop, or of a move's end, from some states in a final brake swings back by a few
+        // raw units.)
+        let turns = |c: &Change| {
+            self.reverses(&c.timeline, p.command, at)
+                && !self.reverses(&self.timeline, p.command, at)
+        };
+        // (Not a stop on the path: a paused move is replanned whole when the override rises.)
+        if !p.paused
+            && replanned
+                .as_ref()
+                .is_ok_and(|c| self.overshoots(c, p.command, at) || turns(c))
+        {
+            let kept = self.plan_change_with(at, Request::Override(k), false, true);
+            if kept
+                .as_ref()
+                .is_ok_and(|c| !self.overshoots(c, p.command, at))
+            {
+                return kept.map(|mut c| {
+                    if k == 0.0 && !c.notes.iter().any(|(n, _)| *n == p.command) {
+                        let note = match p.goal {
+                            Goal::Position { velocity, .. } if velocity != 0.0 => PASSED_ON,
+                            _ => STOPPED_ON_TARGET,
+                        };
+                        c.notes.push((p.command, note.into()));
+                    }
+                    c
+                });
+            }
+        }
         if k == 0.0 {
             let past = replanned.as_ref().is_ok_and(|c| {
                 c.notes
@@ -143,22 +169,6 @@ impl HostAxis {
             } else {
                 replanned
             };
-        }
-        // A change the move playing at `at` cannot follow without turning back (its target
-        // too near to slow to the new speed, or to the blend it asks, in time): that move
-        // plays on as planned, the override acts from the next one.
-        if k > 0.0
-            && replanned
-                .as_ref()
-                .is_ok_and(|c| self.turns_back(c, p.command, at))
-        {
-            let kept = self.plan_change_with(at, Request::Override(k), false, true);
-            if kept
-                .as_ref()
-                .is_ok_and(|c| !self.turns_back(c, p.command, at))
-            {
-                return kept;
-            }
         }
         let keeps = k > 0.0
             && self.slows_to_its_end(p, at)
@@ -211,24 +221,66 @@ impl HostAxis {
         true
     }
 
-    /// True when change `c` makes command `command`'s motion from tick `at` turn back against
-    /// the direction it moves in at `at` (an overshoot of its target and a return), judged
-    /// at every segment's end and middle.
-    fn turns_back(&self, c: &Change, command: usize, at: u64) -> bool {
-        let w = &self.settings.format.widths;
-        let dir = self.timeline.state_at(at, &self.settings.format).v.signum();
+    /// True when `timeline` makes command `command`'s motion after tick `at` go against the
+    /// direction it moves in at `at`, judged at every segment's end and middle.
+    fn reverses(&self, timeline: &Timeline, command: usize, at: u64) -> bool {
+        let f = &self.settings.format;
+        let dir = self.timeline.state_at(at, f).v.signum();
+        dir != 0
+            && timeline
+                .parts
+                .iter()
+                .filter(|q| q.command == command && q.end_tick() > at)
+                .any(|q| {
+                    let mut tick = q.start_tick;
+                    q.program.segments.iter().any(|s| {
+                        let half = tick + u64::from(s.ticks) / 2;
+                        tick += u64::from(s.ticks);
+                        [half, tick].iter().any(|&t| {
+                            t > at
+                                && q.start
+                                    .after_ticks(&q.program, t - q.start_tick, &f.widths)
+                                    .v
+                                    * dir
+                                    < 0
+                        })
+                    })
+                })
+    }
+
+    /// True when change `c` makes command `command`'s move to a position pass its target cell
+    /// after tick `at` (to come back to it), judged at every segment's end and middle.
+    fn overshoots(&self, c: &Change, command: usize, at: u64) -> bool {
+        let f = &self.settings.format;
         c.timeline
             .parts
             .iter()
             .filter(|q| q.command == command && q.end_tick() > at)
             .any(|q| {
-                let mut tick = 0u64;
+                let Goal::Position { cell, .. } = q.goal else {
+                    return false;
+                };
+                let from = at.max(q.start_tick);
+                let x = if q.start_tick >= at {
+                    q.start.x
+                } else {
+                    self.timeline.state_at(at, f).x
+                };
+                let dir = (cell - f.output_lsb(x)).signum();
+                let mut tick = q.start_tick;
                 q.program.segments.iter().any(|s| {
                     let half = tick + u64::from(s.ticks) / 2;
                     tick += u64::from(s.ticks);
-                    [half, tick]
-                        .iter()
-                        .any(|&t| q.start.after_ticks(&q.program, t, w).v * dir < 0)
+                    [half, tick].iter().any(|&t| {
+                        t > from
+                            && (f.output_lsb(
+                                q.start
+                                    .after_ticks(&q.program, t - q.start_tick, &f.widths)
+                                    .x,
+                            ) - cell)
+                                * dir
+                                > 0
+                    })
                 })
             })
     }

@@ -117,6 +117,11 @@ type Planned = (Program, ChainState, Goal, bool, Option<String>);
 pub const STOPPED_ON_TARGET: &str =
     "override 0 too near the target to stop before it: stopped on it";
 
+/// The note of a move on a path whose stop (override 0) would have come to rest past its
+/// end: it passes on into the next element, which stops on its path.
+pub(super) const PASSED_ON: &str =
+    "override 0 too near the element's end to stop before it: passed on";
+
 /// Plans one command's part from `from` with override `k`: a position move to its target at
 /// rest or at the blend velocity with `next`, a velocity, a halt.
 pub(super) fn plan_part(
@@ -131,8 +136,20 @@ pub(super) fn plan_part(
     let run = |target: OnlineTarget, limits: OnlineLimits| {
         plan_online(from, &target, &limits, order, f).map(|p| (p.program, p.final_state))
     };
-    // A stop on the path (override 0, MC_Halt) with the command's deceleration.
-    let stop = |l: OnlineLimits| run(OnlineTarget::Velocity(0.0), l);
+    // A stop on the path (override 0, MC_Halt) with the command's deceleration; at rest, a
+    // tick of standing still (the planner's exact realisation of "to velocity 0" from rest is
+    // a six-tick wiggle of a few raw units).
+    let at_rest = from.v == 0 && from.a == 0 && from.j == 0;
+    let stop = |l: OnlineLimits| {
+        if at_rest {
+            let hold = Program {
+                segments: vec![Segment { ticks: 1, snap: 0 }],
+            };
+            Ok((hold, *from))
+        } else {
+            run(OnlineTarget::Velocity(0.0), l)
+        }
+    };
     match *cmd {
         MotionCommand::Halt { deceleration, jerk } => {
             let l = OnlineLimits {
@@ -201,6 +218,26 @@ pub(super) fn plan_part(
                 if (f.output_lsb(e.x) - cell) * dir < 0 {
                     return Ok((p, e, Goal::Velocity(0.0), true, None));
                 }
+                // On a path, with an element after this one, the stop goes on into it: the
+                // target is passed at the lowest speed found (up to the next element's entry
+                // speed), and the next move stops on its path.
+                let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
+                if path.is_some() && vb != 0.0 {
+                    let most = blend_cap(path, next, false).min(vb.abs());
+                    let through = PASS_THROUGH.iter().find_map(|&share| {
+                        let v = most * share * vb.signum();
+                        let l = OnlineLimits {
+                            velocity: l.velocity.max(v.abs()),
+                            ..l
+                        };
+                        let target = OnlineTarget::Position { cell, velocity: v };
+                        run(target, l).ok().map(|r| (v, r))
+                    });
+                    if let Some((v, (p, e))) = through {
+                        let goal = Goal::Position { cell, velocity: v };
+                        return Ok((p, e, goal, false, Some(PASSED_ON.into())));
+                    }
+                }
                 let (p, e) = run(
                     OnlineTarget::Position {
                         cell,
@@ -250,6 +287,18 @@ pub(super) fn plan_part(
                 };
                 run(at(v), l)
             };
+            // The blend point passed at `v` instead of the blend velocity, and why.
+            let passed = |v: f64, (p, e): (Program, ChainState), why: &str| {
+                let goal = Goal::Position {
+                    cell,
+                    velocity: v * vb.signum(),
+                };
+                let note = format!(
+                    "{why}: the blend velocity {:.3} passed at {v:.3} instead",
+                    vb.abs()
+                );
+                (p, e, goal, false, Some(note))
+            };
             match run(at(vb), l) {
                 Ok((p, e)) => Ok((p, e, Goal::Position { cell, velocity: vb }, false, None)),
                 Err(OnlineError::NotRealisable(_)) if vb != 0.0 => {
@@ -262,18 +311,10 @@ pub(super) fn plan_part(
                         })
                     });
                     match slower {
-                        Some((v, (p, e))) => Ok((
-                            p,
-                            e,
-                            Goal::Position {
-                                cell,
-                                velocity: v * vb.signum(),
-                            },
-                            false,
-                            Some(format!(
-                                "no exact program passes the blend point at {:.3}: passed at {v:.3} instead",
-                                vb.abs()
-                            )),
+                        Some((v, r)) => Ok(passed(
+                            v,
+                            r,
+                            "no exact program passes the blend point at it",
                         )),
                         None => buffered(),
                     }
@@ -309,29 +350,11 @@ pub(super) fn plan_part(
                             }
                         }
                     }
-                    // Never faster than the junction allows; on a path, a slower pass (the
-                    // blend point hit with a small change of speed) before a stop there.
-                    let mut found = found.filter(|(v, _)| *v <= junction);
-                    if found.is_none() && path.is_some() {
-                        found = SLOWER.iter().find_map(|&f| {
-                            let v = vb.abs() * f;
-                            blend(v * vb.signum()).ok().map(|r| (v, r))
-                        });
-                    }
-                    match found {
-                        Some((v, (p, e))) => Ok((
-                            p,
-                            e,
-                            Goal::Position {
-                                cell,
-                                velocity: v * vb.signum(),
-                            },
-                            false,
-                            Some(format!(
-                                "the blend velocity {:.3} could not be reached before the blend point: passed at {v:.3} instead",
-                                vb.abs()
-                            )),
-                        )),
+                    // Never faster than the junction allows.
+                    match found.filter(|(v, _)| *v <= junction) {
+                        Some((v, r)) => {
+                            Ok(passed(v, r, "too fast to slow to it by the blend point"))
+                        }
                         None => buffered(),
                     }
                 }
@@ -340,6 +363,11 @@ pub(super) fn plan_part(
         }
     }
 }
+
+/// The shares of the speed a blend aims at (its entry into the next element) tried, slowest
+/// first, for a move on a path that an override of 0 cannot stop before its end: it passes
+/// on into the next element at the first that plans.
+const PASS_THROUGH: [f64; 8] = [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0];
 
 /// The shares of a blend velocity tried, in turn, when a move on a path can pass its blend
 /// point neither at it (no exact program does) nor faster within its junction's limit.

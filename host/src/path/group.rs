@@ -20,16 +20,18 @@
 
 use ethnum::I256;
 use snapgen_model::chain::{ChainState, Trace};
-use snapgen_model::format::Format;
+use snapgen_model::format::{Format, Quantity};
 use snapgen_model::path::interp::Path;
 use snapgen_model::FRAC_BITS;
 use snapgen_plan::online::OnlineOrder;
 use snapgen_plan::path::junction::{frames, junction_speed, lookahead, Ahead, Frame};
-use snapgen_plan::path::speed::{element_limits, Limits};
+use snapgen_plan::path::speed::{element_limits, Limits, MARGIN};
 use snapgen_plan::path::{prepare, raw, Element, Prepared};
 
 use crate::axis::compose::Request;
-use crate::axis::{AxisErrorId, AxisSettings, BufferMode, HostAxis, MotionCommand, OnPath};
+use crate::axis::{
+    AxisErrorId, AxisSettings, BufferMode, HostAxis, MotionCommand, OnPath, Outcome,
+};
 
 use super::PlayError;
 use crate::gcode::Block;
@@ -101,6 +103,8 @@ pub struct Group<'a> {
     commands: Vec<usize>,
     /// Each move given, as the look-ahead saw it.
     moves: Vec<Ahead>,
+    /// The output cell `s` starts in (0 here; a board's position register where it stands).
+    origin_cell: i128,
     /// The axis on `s`.
     pub axis: HostAxis,
     /// Overrides refused (event index, why).
@@ -134,6 +138,25 @@ struct Move {
     junction: f64,
 }
 
+/// The latest an event may be due (ms from the start: 10⁷ ms, 2.8 hours); a later one, or an
+/// element that is not in the program, is not taken.
+pub const MAX_EVENT_MS: f64 = 1e7;
+
+impl Move {
+    /// As the look-ahead sees it, entered at `entry`.
+    fn ahead(&self, entry: f64) -> Ahead {
+        Ahead {
+            length: self.length,
+            limits: Limits {
+                velocity: self.velocity,
+                acceleration: self.acceleration.min(self.deceleration),
+                jerk: self.jerk,
+            },
+            entry,
+        }
+    }
+}
+
 /// `s` where the path starts: the centre of cell 0.
 pub(super) fn s0() -> i128 {
     raw(0)
@@ -153,6 +176,10 @@ impl<'a> Group<'a> {
         let mut at = vec![0i64; axes.len()];
         let mut planned = Vec::new();
         let mut geometries = Vec::new();
+        // The path length register: the host axis's positions (half its range, a cell per
+        // element for the fitting).
+        let most = format.physical_max(Quantity::Position) * 0.5;
+        let mut total = 0.0;
         for leg in legs {
             let line = leg.line;
             let prepared = prepare(&at, std::slice::from_ref(&leg.element))
@@ -167,6 +194,14 @@ impl<'a> Group<'a> {
                 ..geometric
             };
             let length = prepared.length_physical(format.position_lsb);
+            total += length + format.position_lsb;
+            if total > most {
+                return Err(PlayError::TooLong {
+                    line,
+                    length: total,
+                    most,
+                });
+            }
             let frames = frames(
                 &at,
                 &leg.element,
@@ -181,9 +216,7 @@ impl<'a> Group<'a> {
                 prepared,
                 junction: 0.0,
             });
-            at = match &leg.element {
-                Element::Line { to } | Element::Arc { to, .. } => to.clone(),
-            };
+            at = leg.element.to().to_vec();
         }
         // Each junction's speed (0 from rest, at a corner, into or out of a rapid). On a line
         // that meets another element at speed, an axis whose direction share or curvature
@@ -254,11 +287,33 @@ impl<'a> Group<'a> {
             paths: Vec::new(),
             commands: Vec::new(),
             moves: Vec::new(),
+            origin_cell: 0,
             axis: HostAxis::new(settings, 0, origin),
             refused: Vec::new(),
             taken: Vec::new(),
             junction_scale: 1.0,
         })
+    }
+
+    /// Where a run entering later continues one at speed, the stretch changes at the
+    /// junction (`f0` to `f1`): every moving axis's speed steps by its share times
+    /// `|1/f0 − 1/f1|`, on elements that may use their whole limits there; the step is kept
+    /// within the share of each limit the elements leave (`1 − MARGIN`). Unbounded when the
+    /// stretch does not change.
+    fn restretched(&self, end: &Frame, start: &Frame, f0: f64, f1: f64) -> f64 {
+        let df = (1.0 / f0 - 1.0 / f1).abs();
+        let ts = self.format.ts;
+        let mut v = f64::INFINITY;
+        for (i, l) in self.axes.iter().enumerate() {
+            let step = end.direction[i].abs().max(start.direction[i].abs()) * df;
+            if step > 0.0 {
+                let room = 1.0 - MARGIN;
+                v = v
+                    .min(room * l.acceleration * ts / step)
+                    .min(room * l.jerk * ts * ts / step);
+            }
+        }
+        v
     }
 
     /// An element's acceleration, deceleration and jerk on `s`: its geometry's, within the
@@ -303,9 +358,35 @@ impl<'a> Group<'a> {
     /// continues one already entered at speed changes the stretch at its first junction,
     /// which that junction's speed accounts for (a kink of the stretch's change).
     pub fn enter(&mut self, last: usize, at: u64) {
+        let mut reqs = Vec::new();
+        for cmd in self.moves_for(last) {
+            let k = self.axis.submit(cmd);
+            // A move whose inputs were refused is in Error already.
+            if !self.axis.commands[k].outcome.is_final() {
+                reqs.push(Request::Command(k));
+            }
+        }
+        if reqs.is_empty() {
+            return;
+        }
+        let (change, refused) = self.axis.plan_batch(at, &reqs);
+        if let Some(c) = change {
+            self.axis.apply(c);
+        }
+        // As the driver does: a move the planner refused is in Error.
+        for (r, why) in refused {
+            if let Request::Command(k) = r {
+                self.axis.commands[k].outcome = Outcome::Error(why.error);
+            }
+        }
+    }
+
+    /// The moves on `s` that make the elements up to `last` enter ([`Group::enter`]), in
+    /// order: the host axis's next commands (its `k`-th command is the group's `k`-th move).
+    pub fn moves_for(&mut self, last: usize) -> Vec<MotionCommand> {
         let first = self.entries.len();
         if last < first || last >= self.legs.len() {
-            return;
+            return Vec::new();
         }
         let one = 1i128 << FRAC_BITS;
         // The runs and their stretches.
@@ -348,14 +429,16 @@ impl<'a> Group<'a> {
                     return 0.0;
                 }
                 let q = &self.planned[k - 1];
+                let (f0, f1) = (self.stretch[k - 1], self.stretch[k]);
                 self.junction_scale
                     * junction_speed(
-                        &q.frames.1.stretched(self.stretch[k - 1]),
-                        &p.frames.0.stretched(self.stretch[k]),
+                        &q.frames.1.stretched(f0),
+                        &p.frames.0.stretched(f1),
                         self.axes,
                         self.format.ts,
                         self.format.position_lsb,
                     )
+                    .min(self.restretched(&q.frames.1, &p.frames.0, f0, f1))
                     .min(p.cap)
                     .min(q.cap)
             })
@@ -368,10 +451,14 @@ impl<'a> Group<'a> {
             let (acceleration, deceleration, jerk) = self.own_limits(&p.limits);
             let junction = junctions[k - first];
             let short = |length: f64, speed: f64| length < speed * self.format.ts * SHORT_TICKS;
+            // Joined while the move so far is short (a long move is not slowed to a short
+            // element's speed: the short one starts a move of its own); the last element of
+            // the batch, short, joins the move before it.
+            let end_of_batch = k == last;
             let join = moves.last().is_some_and(|m| {
                 junction > 0.0
                     && (short(m.length, m.velocity.min(junction))
-                        || short(p.length, p.limits.velocity.min(junction)))
+                        || (end_of_batch && short(p.length, p.limits.velocity.min(junction))))
             });
             if join {
                 let m = moves.last_mut().expect("joined to a move");
@@ -399,23 +486,15 @@ impl<'a> Group<'a> {
         let fixed = self.moves.last().copied();
         let window: Vec<Ahead> = fixed
             .into_iter()
-            .chain(moves.iter().map(|m| Ahead {
-                length: m.length,
-                limits: Limits {
-                    velocity: m.velocity,
-                    acceleration: m.acceleration.min(m.deceleration),
-                    jerk: m.jerk,
-                },
-                entry: m.junction,
-            }))
+            .chain(moves.iter().map(|m| m.ahead(m.junction)))
             .collect();
         let skip = window.len() - moves.len();
         let speeds = lookahead(&window);
-        let mut reqs = Vec::new();
+        let mut out = Vec::new();
         let mut k = first;
         for (m, &entry) in moves.iter().zip(&speeds[skip..]) {
             // The cell the move's last element ends in (`s` from the start's cell centre).
-            let cell = (s0() + self.bounds[m.last]) >> FRAC_BITS;
+            let cell = self.origin_cell + ((s0() + self.bounds[m.last]) >> FRAC_BITS);
             let cmd = MotionCommand::MoveAbsolute {
                 position: cell as f64 * self.format.position_lsb,
                 velocity: m.velocity,
@@ -433,28 +512,17 @@ impl<'a> Group<'a> {
                     junction: m.junction.max(entry),
                 }),
             };
-            let c = self.axis.submit(cmd);
-            self.moves.push(Ahead {
-                length: m.length,
-                limits: Limits {
-                    velocity: m.velocity,
-                    acceleration: m.acceleration.min(m.deceleration),
-                    jerk: m.jerk,
-                },
-                entry,
-            });
+            let c = self.moves.len();
+            self.moves.push(m.ahead(entry));
             for i in k..=m.last {
                 self.entries
                     .push(if i == k { entry } else { junctions[i - first] });
                 self.commands.push(c);
             }
             k = m.last + 1;
-            reqs.push(Request::Command(c));
+            out.push(cmd);
         }
-        let (change, _refused) = self.axis.plan_batch(at, &reqs);
-        if let Some(c) = change {
-            self.axis.apply(c);
-        }
+        out
     }
 
     /// The override becomes `k` at tick `at`; refused: why.
@@ -475,15 +543,36 @@ impl<'a> Group<'a> {
         let ts = self.format.ts;
         let mut now = 0u64;
         for (i, e) in events.iter().enumerate() {
+            let known = match e.action {
+                PathAction::Enter(k) => k < self.legs.len(),
+                PathAction::Override(_) => true,
+            };
+            if !(known && e.at_ms.is_finite() && (0.0..=MAX_EVENT_MS).contains(&e.at_ms)) {
+                self.taken.push(None);
+                continue;
+            }
             let due = ((e.at_ms * 1e-3 / ts).round().max(0.0) as u64).max(now);
             let due = match e.at_length {
                 None => Some(due),
                 Some(len) => self.reaches(len, due),
             };
-            let Some(due) = due else {
+            let Some(mut due) = due else {
                 self.taken.push(None);
                 continue;
             };
+            // An override that raises the speed while a stop on the path is still braking acts
+            // once it has come to rest (a replan from its last ticks may swing back).
+            if matches!(e.action, PathAction::Override(k) if k > 0.0) {
+                if let Some(p) = self
+                    .axis
+                    .timeline
+                    .parts
+                    .iter()
+                    .find(|p| p.paused && p.start_tick <= due && due < p.end_tick())
+                {
+                    due = p.end_tick();
+                }
+            }
             now = due;
             self.taken.push(Some(due));
             match e.action {
@@ -524,6 +613,12 @@ impl<'a> Group<'a> {
 
     /// Every axis on every tick (raw), `s` mapped through the entered elements' rules.
     pub fn trace(&self) -> Vec<Vec<i128>> {
+        self.map(&self.lengths())
+    }
+
+    /// Every axis at each path length of `lengths` (raw `s`, the chain's register: from a
+    /// board, its position register), through the entered elements' rules.
+    pub fn map(&self, lengths: &[i128]) -> Vec<Vec<i128>> {
         let segments = self
             .paths
             .iter()
@@ -531,10 +626,27 @@ impl<'a> Group<'a> {
             .collect();
         let path = Path { segments };
         let origin: Vec<i128> = self.axes.iter().map(|_| raw(0)).collect();
-        self.lengths()
-            .into_iter()
-            .map(|s| path.at(s - s0()).unwrap_or_else(|| origin.clone()))
+        lengths
+            .iter()
+            .map(|&s| path.at(self.along(s)).unwrap_or_else(|| origin.clone()))
             .collect()
+    }
+
+    /// How far along the path (raw, from its start's cell centre) a path length register of
+    /// `s` is.
+    pub fn along(&self, s: i128) -> i128 {
+        s - ((self.origin_cell << FRAC_BITS) + s0())
+    }
+
+    /// The position (units) of `length` units along the path on the path length register.
+    pub fn position_of(&self, length: f64) -> f64 {
+        self.origin_cell as f64 * self.format.position_lsb + length
+    }
+
+    /// The group for a board whose position register (`s`) stands at `x` (raw) at rest.
+    pub fn on_board(mut self, x: i128) -> Self {
+        self.origin_cell = x >> FRAC_BITS;
+        self
     }
 }
 
@@ -633,14 +745,7 @@ mod tests {
         assert!(run.lengths.windows(2).all(|w| w[1] >= w[0]));
         assert!(run.blocks[1].entry > 10.0 && run.blocks[2].entry > 10.0);
         // The end exactly on its cell.
-        let end: Vec<i128> = run
-            .trace
-            .last()
-            .unwrap()
-            .iter()
-            .map(|x| x >> FRAC_BITS)
-            .collect();
-        assert_eq!(end, vec![60_000, 30_000]);
+        assert_eq!(run.end_cells(), vec![60_000, 30_000]);
     }
 
     #[test]
@@ -651,23 +756,11 @@ mod tests {
             let mut g = Group::new(&blocks, &[AXIS; 2], None, &F).unwrap();
             g.junction_scale = scale;
             g.play(&events);
-            let run = crate::path::Run {
-                blocks: Vec::new(),
-                trace: g.trace(),
-                lengths: g.lengths(),
-                taken: g.taken.clone(),
-                refused: Vec::new(),
-            };
+            let run = crate::path::collect(&g, &g.axis, &blocks, g.lengths()).unwrap();
             (g.entries().to_vec(), run)
         };
         let (entries, run) = play(1.0);
-        let mut all = blocks.clone();
-        all.truncate(3);
-        let check = |run: &crate::path::Run| {
-            let mut r = run.clone();
-            r.blocks = vec![dummy(); 3];
-            verify(&r, &all, &[AXIS; 2], &F)
-        };
+        let check = |run: &crate::path::Run| verify(run, &blocks, &[AXIS; 2], &F);
         assert_eq!(check(&run).exceeded, None);
         // √(½·0.98·2e6·1e-4·20) = 44.3 mm/s at both junctions.
         assert!((entries[1] - 44.27).abs() < 0.01, "{entries:?}");
@@ -682,22 +775,10 @@ mod tests {
         );
     }
 
-    fn dummy() -> crate::path::Played {
-        crate::path::Played {
-            line: 0,
-            kind: "line",
-            length: 0.0,
-            limits: AXIS,
-            entry: 0.0,
-            joined: false,
-            outcome: crate::axis::Outcome::Done,
-            ticks: 0,
-        }
-    }
-
     #[test]
     fn a_full_override_never_passes_an_elements_speed_limit() {
-        // A feed the arc cannot take: its centripetal limit caps it, whatever the override.
+        // A feed the lines cannot take at 200 %: their cap (the axes' velocity) holds, and the
+        // arc's (its centripetal limit) too.
         let blocks = chain(250.0);
         let events = [over(0.0, 2.0), enter(0.0, None, 2)];
         let run = crate::path::play_events(&blocks, &[AXIS; 2], None, &F, &events).unwrap();

@@ -9,6 +9,7 @@
 //! against the path as programmed and each axis's limits (`snapgen_verify::path`): lines within
 //! 1 LSB on every axis, arcs within 2.
 
+pub mod board;
 pub mod group;
 
 use snapgen_model::{Format, Quantity, FRAC_BITS};
@@ -16,7 +17,7 @@ use snapgen_plan::path::speed::Limits;
 use snapgen_plan::path::{Element, PathError};
 use snapgen_verify::path as check;
 
-use crate::axis::{AxisErrorId, Outcome};
+use crate::axis::{AxisErrorId, HostAxis, Outcome};
 use crate::gcode::Block;
 pub use group::{Group, PathAction, PathEvent, PathLimits};
 
@@ -36,6 +37,16 @@ pub enum PlayError {
     Still {
         /// Its line.
         line: usize,
+    },
+    /// The path is longer than the path-length register holds.
+    #[error("line {line}: the path reaches {length:.3} units there, beyond the {most:.3} its length register holds: split the program or give a coarser --lsb")]
+    TooLong {
+        /// The block.
+        line: usize,
+        /// The path's length at its end (units).
+        length: f64,
+        /// The most the register holds (units).
+        most: f64,
     },
     /// The block's move ended in Error.
     #[error("line {line}: {source}")]
@@ -85,6 +96,15 @@ pub struct Run {
     pub refused: Vec<(usize, AxisErrorId)>,
 }
 
+impl Run {
+    /// The output cell every axis ends in.
+    pub fn end_cells(&self) -> Vec<i128> {
+        self.trace
+            .last()
+            .map_or_else(Vec::new, |p| p.iter().map(|x| x >> FRAC_BITS).collect())
+    }
+}
+
 /// What the independent check found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checked {
@@ -94,6 +114,9 @@ pub struct Checked {
     pub exceeded: Option<check::Exceeded>,
     /// Each axis's peak velocity, acceleration and jerk (mm/s, /s², /s³).
     pub peaks: Vec<[f64; 3]>,
+    /// On every tick, how far the axes are from the element they follow (LSB, `f64`:
+    /// `snapgen_verify::path::Element::distance`), for pictures and reports.
+    pub distance: Vec<f64>,
 }
 
 /// Plays `blocks` from the origin with `axes` (X, Y, Z) limits in `format` (mm, its LSB and
@@ -121,20 +144,40 @@ pub fn play_events(
 ) -> Result<Run, PlayError> {
     let mut g = Group::new(blocks, axes, own, format)?;
     g.play(events);
-    let lengths = g.lengths();
+    let mut run = collect(&g, &g.axis, blocks, g.lengths())?;
+    run.taken = g.taken.clone();
+    run.refused = g.refused.clone();
+    Ok(run)
+}
+
+/// What `g` played of `blocks` through `axis` (its commands' outcomes), its path length on
+/// every tick being `lengths` (raw `s`); no event recorded.
+pub fn collect(
+    g: &Group,
+    axis: &HostAxis,
+    blocks: &[Block],
+    lengths: Vec<i128>,
+) -> Result<Run, PlayError> {
     // Ticks on each element: those whose `s` lies within its share.
     let mut on = vec![0u64; g.bounds().len()];
-    for s in &lengths {
-        let r = s - group::s0();
-        let k = g.bounds().partition_point(|&b| b <= r);
-        if let Some(n) = on.get_mut(k) {
+    for &s in &lengths {
+        let r = g.along(s);
+        // At rest on an end, within half a cell past it: still that element's.
+        let k = g
+            .bounds()
+            .partition_point(|&b| b <= r - (1 << (FRAC_BITS - 1)));
+        let last = on.len().saturating_sub(1);
+        if let Some(n) = on.get_mut(k.min(last)) {
             *n += 1;
         }
     }
     let mut played = Vec::new();
     for (k, (&entry, &c)) in g.entries().iter().zip(g.commands()).enumerate() {
         let b = &blocks[k];
-        let rec = &g.axis.commands[c];
+        // Elements whose move was never given (its event not taken) were not played.
+        let Some(rec) = axis.commands.get(c) else {
+            break;
+        };
         if let Outcome::Error(e) = &rec.outcome {
             return Err(PlayError::Move {
                 line: b.line,
@@ -159,10 +202,10 @@ pub fn play_events(
     }
     Ok(Run {
         blocks: played,
-        trace: g.trace(),
+        trace: g.map(&lengths),
         lengths,
-        taken: g.taken.clone(),
-        refused: g.refused.clone(),
+        taken: Vec::new(),
+        refused: Vec::new(),
     })
 }
 
@@ -171,11 +214,7 @@ pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits], format: &Format) -> 
     let mut at = vec![0i128; axes.len()];
     let mut path = Vec::new();
     for b in &blocks[..run.blocks.len()] {
-        let to: Vec<i128> = match &b.element {
-            Element::Line { to } | Element::Arc { to, .. } => {
-                to.iter().map(|&x| x.into()).collect()
-            }
-        };
+        let to: Vec<i128> = b.element.to().iter().map(|&x| x.into()).collect();
         path.push(match &b.element {
             Element::Line { .. } => check::Element::Line(check::Line {
                 from: at.clone(),
@@ -211,6 +250,26 @@ pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits], format: &Format) -> 
             Err(e) => unreachable!("the blocks' path is well formed: {e}"),
         }
     };
+    // The distance from the element followed: the next one once it is nearer.
+    let lsb = |x: i128| x as f64 / 2f64.powi(FRAC_BITS as i32) - 0.5;
+    let mut k = 0;
+    let distance: Vec<f64> = run
+        .trace
+        .iter()
+        .map(|p| {
+            let p: Vec<f64> = p.iter().map(|&x| lsb(x)).collect();
+            let Some(mut d) = path.get(k).map(|e| e.distance(&p)) else {
+                return 0.0;
+            };
+            while let Some(next) = path.get(k + 1).map(|e| e.distance(&p)) {
+                if next > d {
+                    break;
+                }
+                (k, d) = (k + 1, next);
+            }
+            d
+        })
+        .collect();
     let s = |q| format.scale(q);
     let raw: Vec<check::AxisLimits> = axes
         .iter()
@@ -238,6 +297,7 @@ pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits], format: &Format) -> 
                 ]
             })
             .collect(),
+        distance,
     }
 }
 
@@ -277,14 +337,7 @@ mod tests {
         let c = verify(&run, &blocks, &[AXIS; 3], &F);
         assert_eq!((c.deviation, c.exceeded), (None, None));
         // The end: (5, 5, -1) mm exactly.
-        let end: Vec<i128> = run
-            .trace
-            .last()
-            .unwrap()
-            .iter()
-            .map(|x| x >> FRAC_BITS)
-            .collect();
-        assert_eq!(end, vec![5_000_000, 5_000_000, -1_000_000]);
+        assert_eq!(run.end_cells(), vec![5_000_000, 5_000_000, -1_000_000]);
         // Not blind: the same trace checked against tighter axes fails.
         let tight = Limits {
             velocity: 10.0,

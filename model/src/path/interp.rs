@@ -3,7 +3,8 @@
 //! by integer rules a fabric can follow once per tick.
 //!
 //! A path is a list of [`Segment`]s, each with its length in `s` (raw) and its shape, prepared
-//! by the host (`snapgen_plan::path`). Within a segment, at `r = s − start` (`0 ≤ r ≤ length`):
+//! by the host (`snapgen_plan::path`). Within a segment, at `r = s − start` (`0 ≤ r ≤ length`;
+//! the path's first and last segments up to a cell beyond, [`Path::at`]):
 //!
 //! * **Line**: `xᵢ = fromᵢ + ((r · dirᵢ) >> 62)`, `dirᵢ` the axis's share of the length
 //!   (`Δxᵢ / length`, 62 fraction bits).
@@ -72,7 +73,8 @@ fn mul_shift(a: i128, b: i128, shift: u32) -> i128 {
 }
 
 impl Segment {
-    /// Every axis at `r` into the segment (`0 ≤ r ≤ length`).
+    /// Every axis at `r` into the segment (`0 ≤ r ≤ length`, or up to a cell beyond: the rule
+    /// goes on).
     pub fn at(&self, r: i128) -> Vec<i128> {
         match &self.shape {
             Shape::Line { from, dir } => from
@@ -126,22 +128,20 @@ impl Path {
     }
 
     /// Every axis at path length `s`: the segment `s` lies in (a segment's end belongs to it
-    /// only at the path's end: elsewhere the next one starts there); `s` below 0 is the start.
-    /// Beyond the length the last segment's rule goes on for up to one output cell (a chain
-    /// brought to rest on a position ends within that cell's width of it, on either side: the
-    /// axes run on smoothly, then stop, rather than stopping while `s` still moves), then
-    /// stays. None for a path without segments.
+    /// only at the path's end: elsewhere the next one starts there). Before 0 the first
+    /// segment's rule, and beyond the length the last one's, go on for up to one output cell
+    /// (a chain at rest on a position stands within a cell's width of it, on either side: the
+    /// axes move smoothly with `s` rather than starting or stopping while it moves), then
+    /// stay. None for a path without segments.
     pub fn at(&self, s: i128) -> Option<Vec<i128>> {
         let mut start = 0i128;
         let last = self.segments.len().checked_sub(1)?;
         for (k, g) in self.segments.iter().enumerate() {
             if s < start + g.length || k == last {
-                let beyond = if k == last {
-                    1i128 << crate::FRAC_BITS
-                } else {
-                    0
-                };
-                return Some(g.at((s - start).clamp(0, g.length + beyond)));
+                let cell = 1i128 << crate::FRAC_BITS;
+                let before = if k == 0 { -cell } else { 0 };
+                let beyond = if k == last { cell } else { 0 };
+                return Some(g.at((s - start).clamp(before, g.length + beyond)));
             }
             start += g.length;
         }
@@ -230,7 +230,12 @@ mod tests {
             Some(vec![105 + cell]),
             "beyond the end: on for a cell"
         );
-        assert_eq!(p.at(-3), Some(vec![0]));
+        assert_eq!(
+            p.at(-3),
+            Some(vec![-3]),
+            "before the start: back for a cell"
+        );
+        assert_eq!(p.at(-cell - 9), Some(vec![-cell]));
         assert_eq!(Path { segments: vec![] }.at(0), None);
     }
 }

@@ -213,9 +213,10 @@ pub fn lookahead(elements: &[Ahead]) -> Vec<f64> {
         .iter()
         .enumerate()
         .map(|(k, e)| {
+            // The first element's entry is given (0 from rest, or a move already running).
             let before = k
                 .checked_sub(1)
-                .map_or(0.0, |p| elements[p].limits.velocity);
+                .map_or(e.entry, |p| elements[p].limits.velocity);
             e.entry.min(e.limits.velocity).min(before)
         })
         .collect();

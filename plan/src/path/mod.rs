@@ -49,6 +49,15 @@ pub enum Element {
     },
 }
 
+impl Element {
+    /// Its end point.
+    pub fn to(&self) -> &[i64] {
+        match self {
+            Element::Line { to } | Element::Arc { to, .. } => to,
+        }
+    }
+}
+
 /// Why a path cannot be prepared.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PathError {
@@ -158,9 +167,7 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
     let mut geometries = Vec::new();
     let mut at: Vec<i64> = start.to_vec();
     for (k, e) in elements.iter().enumerate() {
-        let to = match e {
-            Element::Line { to } | Element::Arc { to, .. } => to,
-        };
+        let to = e.to();
         if to.len() != axes {
             return Err(PathError::Axes {
                 element: k,
@@ -258,7 +265,7 @@ pub fn prepare(start: &[i64], elements: &[Element]) -> Result<Prepared, PathErro
                 });
             }
         }
-        at = to.clone();
+        at = to.to_vec();
     }
     Ok(Prepared {
         start: start.to_vec(),

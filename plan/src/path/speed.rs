@@ -13,10 +13,10 @@
 //!   given to the centripetal terms, half to the path's own, and `v` lowered until the
 //!   centripetal terms fit their half.
 //!
-//! Every element is planned from rest to rest here (the exact stop at every block end,
-//! PLCopen Buffered), so no curvature jumps at speed. The tick adds to what the derivatives
-//! say (a third difference of sampled positions is not exactly `x⃛·Ts³`): the limits given
-//! are kept [`MARGIN`] below.
+//! These are the limits along an element; where two meet at speed, the curvature jump and any
+//! kink are the junction's ([`super::junction`]). The tick adds to what the derivatives say (a
+//! third difference of sampled positions is not exactly `x⃛·Ts³`): the limits given are kept
+//! [`MARGIN`] below.
 
 /// The share of each limit the derivation uses (the rest absorbs the tick's discretisation).
 pub const MARGIN: f64 = 0.98;

@@ -70,6 +70,43 @@ impl Element {
         }
     }
 
+    /// How far `p` (in LSBs, `f64`) is from the element: from the nearest point of a line;
+    /// radially in an arc's plane from its circle (through its start), a helix's climb not
+    /// counted. For reports and pictures (the check is [`Element::holds`], exact).
+    pub fn distance(&self, p: &[f64]) -> f64 {
+        let f = |v: &[i128]| v.iter().map(|&x| x as f64).collect::<Vec<f64>>();
+        match self {
+            Element::Line(l) => {
+                let (a, b) = (f(&l.from), f(&l.to));
+                let d: Vec<f64> = a.iter().zip(&b).map(|(a, b)| b - a).collect();
+                let dd: f64 = d.iter().map(|x| x * x).sum();
+                let t = if dd > 0.0 {
+                    let dot: f64 = p
+                        .iter()
+                        .zip(&a)
+                        .zip(&d)
+                        .map(|((p, a), d)| (p - a) * d)
+                        .sum();
+                    (dot / dd).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                p.iter()
+                    .zip(&a)
+                    .zip(&d)
+                    .map(|((p, a), d)| (p - a - t * d).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            }
+            Element::Arc(arc) => {
+                let [i, j] = arc.plane;
+                let (cx, cy) = (arc.centre[0] as f64, arc.centre[1] as f64);
+                let radius = (arc.from[i] as f64 - cx).hypot(arc.from[j] as f64 - cy);
+                ((p[i] - cx).hypot(p[j] - cy) - radius).abs()
+            }
+        }
+    }
+
     /// True when `p` lies on the element within its kind's bound.
     pub fn holds(&self, p: &[i128], bounds: Bounds) -> bool {
         match self {
@@ -301,6 +338,25 @@ pub(crate) fn big(x: i128) -> BigInt {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn distance_is_from_a_lines_nearest_point_and_an_arcs_circle() {
+        let line = Element::Line(Line {
+            from: vec![0, 0],
+            to: vec![1000, 0],
+        });
+        assert_eq!(line.distance(&[500.0, 3.0]), 3.0);
+        assert_eq!(line.distance(&[1004.0, 3.0]), 5.0, "past the end: from the end");
+        let arc = Element::Arc(Arc {
+            plane: [0, 1],
+            centre: [0, 0],
+            direction: Direction::CounterClockwise,
+            from: vec![100, 0],
+            to: vec![0, 100],
+        });
+        assert!((arc.distance(&[0.0, 98.5]) - 1.5).abs() < 1e-12);
+        assert!((arc.distance(&[60.0, 80.0])).abs() < 1e-12);
+    }
 
     /// A slot: a line from (0, 0) to (1000, 0), a half turn counter-clockwise around
     /// (1000, 500) to (1000, 1000), a line back to (0, 1000); with z climbing 300 on the arc.

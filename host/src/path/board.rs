@@ -1,0 +1,110 @@
+//! The axis group on a board: the board's chain integrates the path length `s` (its position
+//! register), as the seed's trajectory generator does; the host gives it the group's moves and
+//! overrides through the driver (`crate::driver`, every READ_STATE checked bit for bit against
+//! the host's prediction) and maps the register's trace onto the axes with the interpolator's
+//! rules. The board's format (its Ts and widths) and its position at rest are read from it
+//! before anything is planned.
+//!
+//! The interpolator runs on the host here: the N-axis fabric (the sequencer and the rules in
+//! the fabric) is not built.
+
+use snapgen_model::chain::Trace;
+use snapgen_plan::online::OnlineOrder;
+use snapgen_plan::path::speed::Limits;
+
+use crate::driver::{Action, Event, RunOptions, RunReport};
+use crate::gcode::Block;
+use crate::link::Link;
+use crate::online::{play, PlayError as ScriptError, PlayOptions};
+use crate::session::Session;
+
+use super::group::{Group, PathAction, PathEvent, PathLimits};
+use super::{collect, PlayError, Run};
+
+/// Why a path could not be played on a board.
+#[derive(Debug, thiserror::Error)]
+pub enum BoardError {
+    /// The path (see the message), before anything moved.
+    #[error(transparent)]
+    Path(#[from] PlayError),
+    /// The board: its set-up, the link, or the run.
+    #[error(transparent)]
+    Board(#[from] ScriptError),
+    /// Reading the board's state before the run.
+    #[error("reading the board's state: {0}")]
+    State(String),
+}
+
+/// The driver's script for the group's `events`: each element entering is its moves (at the
+/// event's time, or once the register has reached its length), each override an override.
+/// Returns the script and, for each path event, its first script event (None: nothing to
+/// give, an element not in the program or already entered).
+fn script(g: &mut Group, events: &[PathEvent]) -> (Vec<Event>, Vec<Option<usize>>) {
+    let mut out = Vec::new();
+    let mut first = Vec::new();
+    for e in events {
+        let at_position = e.at_length.map(|l| g.position_of(l));
+        let actions: Vec<Action> = match e.action {
+            PathAction::Enter(k) => g.moves_for(k).into_iter().map(Action::Command).collect(),
+            PathAction::Override(k) => vec![Action::Override { r#override: k }],
+        };
+        first.push((!actions.is_empty()).then_some(out.len()));
+        out.extend(actions.into_iter().map(|action| Event {
+            at_ms: e.at_ms,
+            at_position,
+            action,
+        }));
+    }
+    (out, first)
+}
+
+/// Plays `blocks` as `events` let them enter, with the path's `own` limits, on the board of
+/// `session`: the run's report and the path played (every axis on every tick from the
+/// board's register), with the stop-limit rule's warnings.
+pub fn play_on_board<L: Link>(
+    session: &mut Session<L>,
+    blocks: &[Block],
+    axes: &[Limits],
+    own: Option<PathLimits>,
+    events: &[PathEvent],
+    run: RunOptions,
+) -> Result<(Run, RunReport, Vec<String>), BoardError> {
+    let format = session.format;
+    let at = session
+        .state()
+        .map_err(|e| BoardError::State(e.to_string()))?;
+    let mut g = Group::new(blocks, axes, own, &format)?.on_board(at.x);
+    let (driver_events, first) = script(&mut g, events);
+    let opts = PlayOptions {
+        order: OnlineOrder::Three,
+        stop_deceleration: None,
+        stop_jerk: None,
+        run,
+    };
+    let (report, _, warnings) = play(session, &driver_events, &opts)?;
+    let t = &report.axis.timeline;
+    let (t0, origin) = t.origin;
+    let program = t.played(report.last.ticks);
+    let lengths: Vec<i128> = Trace::new(&program, origin, format.widths)
+        .map(|k| k.state.x)
+        .collect();
+    let mut played = collect(&g, &report.axis, blocks, lengths)?;
+    played.taken = first
+        .iter()
+        .map(|f| {
+            f.and_then(|i| report.event_ticks.get(i))
+                .map(|t| t.saturating_sub(t0))
+        })
+        .collect();
+    played.refused = report
+        .refused_overrides
+        .iter()
+        .filter_map(|(i, why)| {
+            first
+                .iter()
+                .position(|f| *f == Some(*i))
+                .map(|k| (k, why.clone()))
+        })
+        .collect();
+    Ok((played, report, warnings))
+}
