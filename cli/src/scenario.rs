@@ -134,21 +134,22 @@ pub fn cell_mm(mm: f64, f: &snapgen_model::Format) -> i128 {
 }
 
 /// Seed 002's demonstration as a Cartesian path (`snapgen path --scenario seed002`): the
-/// same set speeds and times as the single-axis script ([`Scenario::Seed002`]), on a 400 mm
-/// line along X and a 100 mm counter-clockwise arc of radius 200 mm tangent to it, entering the
-/// buffer at 300 mm. The arc's curvature begins at full speed at the junction: the planner
-/// passes it at the speed that jump allows the Y axis (`snapgen_plan::path::junction`).
+/// single-axis script ([`Scenario::Seed002`]: its moves' lengths, set speed, limits, events
+/// and times) on a line along X and a counter-clockwise arc of radius 200 mm tangent to it,
+/// the arc entering the buffer where the script's second move does. The arc's curvature
+/// begins at full speed at the junction: the planner passes it at the speed that jump allows
+/// the Y axis (`snapgen_plan::path::junction`).
 pub mod seed002_path {
+    use snapgen_host::axis::MotionCommand;
+    use snapgen_host::driver::Action;
     use snapgen_host::gcode::Block;
     use snapgen_host::path::{PathAction, PathEvent, PathLimits};
     use snapgen_plan::path::speed::Limits;
     use snapgen_plan::path::Element;
 
-    /// The line's length (mm).
-    pub const LINE: f64 = 400.0;
-    /// The arc's length (mm) and radius (mm).
-    pub const ARC: f64 = 100.0;
-    /// Its radius (mm).
+    use super::Scenario;
+
+    /// The arc's radius (mm).
     pub const RADIUS: f64 = 200.0;
     /// The machine's axes (ours: the seed has one coordinate): velocity, acceleration and
     /// jerk of X, Y and Z.
@@ -158,68 +159,72 @@ pub mod seed002_path {
         jerk: 2e6,
     };
 
-    /// The blocks on a grid of `lsb` mm.
-    pub fn blocks(lsb: f64) -> Vec<Block> {
+    /// The path from the script at `jerk`: its blocks on a grid of `lsb` mm, the path's own
+    /// limits (the moves' acceleration, deceleration and jerk), the events.
+    pub fn path(jerk: f64, lsb: f64) -> anyhow::Result<(Vec<Block>, PathLimits, Vec<PathEvent>)> {
+        let script = Scenario::Seed002.script(Some(jerk))?;
+        let (mut ends, mut feed, mut own) = (Vec::new(), 0.0, None);
+        let mut events = Vec::new();
+        for e in &script.events {
+            let action = match e.action {
+                Action::Override { r#override } => PathAction::Override(r#override),
+                Action::Command(MotionCommand::MoveAbsolute {
+                    position,
+                    velocity,
+                    acceleration,
+                    deceleration,
+                    jerk,
+                    ..
+                }) => {
+                    ends.push(position);
+                    feed = velocity;
+                    own = Some(PathLimits {
+                        acceleration,
+                        deceleration,
+                        jerk,
+                    });
+                    PathAction::Enter(ends.len() - 1)
+                }
+                _ => anyhow::bail!("the seed 002 script has a command a path does not take"),
+            };
+            events.push(PathEvent {
+                at_ms: e.at_ms,
+                at_length: e.at_position,
+                action,
+            });
+        }
+        let (&[line, end], Some(own)) = (&ends[..], own) else {
+            anyhow::bail!("the seed 002 script has not two moves");
+        };
         let at = |mm: f64| (mm / lsb).round() as i64;
-        let phi = ARC / RADIUS;
-        let end = [
-            at(LINE + RADIUS * phi.sin()),
+        let phi = (end - line) / RADIUS;
+        let to = vec![
+            at(line + RADIUS * phi.sin()),
             at(RADIUS - RADIUS * phi.cos()),
             0,
         ];
-        vec![
-            Block {
-                line: 1,
-                element: Element::Line {
-                    to: vec![at(LINE), 0, 0],
-                },
-                feed: Some(200.0),
-            },
-            Block {
-                line: 2,
-                element: Element::Arc {
-                    plane: [0, 1],
-                    centre: [at(LINE), at(RADIUS)],
-                    ccw: true,
-                    to: end.to_vec(),
-                },
-                feed: Some(200.0),
-            },
-        ]
-    }
-
-    /// The path's own limits: the seed's acceleration, deceleration and `jerk`.
-    pub fn limits(jerk: f64) -> PathLimits {
-        PathLimits {
-            acceleration: 4000.0,
-            deceleration: 3000.0,
-            jerk,
-        }
-    }
-
-    /// The events: the set speeds as overrides of 200 mm/s, the arc entering at 300 mm.
-    pub fn events() -> Vec<PathEvent> {
-        let feed = |at_ms, k| PathEvent {
-            at_ms,
-            at_length: None,
-            action: PathAction::Override(k),
+        let block = |line, element| Block {
+            line,
+            element,
+            feed: Some(feed),
         };
-        vec![
-            feed(0.0, 0.5),
-            PathEvent {
-                at_ms: 0.0,
-                at_length: None,
-                action: PathAction::Enter(0),
-            },
-            feed(800.0, 1.0),
-            feed(1300.0, 0.25),
-            feed(2000.0, 0.75),
-            PathEvent {
-                at_ms: 2000.0,
-                at_length: Some(300.0),
-                action: PathAction::Enter(1),
-            },
-            feed(3000.0, 0.4),
-        ]
+        let blocks = vec![
+            block(
+                1,
+                Element::Line {
+                    to: vec![at(line), 0, 0],
+                },
+            ),
+            block(
+                2,
+                Element::Arc {
+                    plane: [0, 1],
+                    centre: [at(line), at(RADIUS)],
+                    ccw: true,
+                    to,
+                },
+            ),
+        ];
+        Ok((blocks, own, events))
     }
 }

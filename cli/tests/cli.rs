@@ -575,6 +575,16 @@ fn online_refuses_a_bad_script_with_exit_2() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("order = 5"));
 }
 
+/// The X, Y, Z (mm) of every row of `snapgen path --csv`.
+fn path_rows(csv: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|r| r.split(',').skip(2).map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
 /// `snapgen path`: the example part is played, passes its independent check and ends where it
 /// began; a program with an unsupported word is refused with its line (exit 2) before anything
 /// moves.
@@ -603,16 +613,10 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
     assert!(picture.contains("path, XY plane") && picture.contains("jerk (mm/s^3)"));
     assert!(picture.contains("distance from the programmed path"));
     assert!(text.contains("farthest from the programmed path"), "{text}");
-    let rows = std::fs::read_to_string(&csv).unwrap();
-    let last = rows.lines().last().unwrap();
-    let xyz: Vec<f64> = last
-        .split(',')
-        .skip(2)
-        .map(|v| v.parse().unwrap())
-        .collect();
+    let xyz = path_rows(&csv).pop().unwrap();
     assert!(
         xyz.len() == 3 && xyz.iter().all(|v| v.abs() < 1e-9),
-        "{last}"
+        "{xyz:?}"
     );
     let out = snapgen(&["path", "--gcode", part, "--json"]);
     assert_ok(&out);
@@ -670,12 +674,9 @@ fn path_plays_seed002_as_a_path_and_the_part_under_overrides() {
             .iter()
             .all(|e| e["tick"].is_u64() && e["refused"].is_null()));
         // The arc enters on the first tick X (the path length, on the line) is 300 mm along.
-        let rows = std::fs::read_to_string(&csv).unwrap();
-        let reached = rows
-            .lines()
-            .skip(1)
-            .map(|r| r.split(',').nth(2).unwrap().parse::<f64>().unwrap())
-            .position(|x| x >= 300.0 - 0.5e-6)
+        let reached = path_rows(&csv)
+            .iter()
+            .position(|p| p[0] >= 300.0 - 0.5e-6)
             .unwrap();
         assert_eq!(events[5]["tick"].as_u64(), Some(reached as u64), "{jerk}");
     }
@@ -725,15 +726,7 @@ fn path_runs_its_length_on_a_virtual_board() {
     assert_eq!(v["checked"], true, "{v}");
     assert_eq!(v["ts"].as_f64(), Some(1e-5));
     assert!(v["blocks"][1]["entry"].as_f64().unwrap() > 0.5, "{v}");
-    let rows = std::fs::read_to_string(&csv).unwrap();
-    let last: Vec<f64> = rows
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .skip(2)
-        .map(|x| x.parse().unwrap())
-        .collect();
+    let last = path_rows(&csv).pop().unwrap();
     assert!(
         (last[0] - 4.0).abs() < 1e-6 && (last[1] - 3.0).abs() < 1e-6,
         "{last:?}"

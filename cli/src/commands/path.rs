@@ -181,15 +181,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             events.sort_by(|x, y| x.at_ms.total_cmp(&y.at_ms));
             (file.display().to_string(), blocks, None, events)
         }
-        None => (
-            format!(
+        None => {
+            let (blocks, own, events) =
+                seed002_path::path(a.jerk, a.lsb).map_err(InputError::Script)?;
+            let name = format!(
                 "seed 002 as a path: 400 mm line, tangent 100 mm arc (R 200 mm) entering at 300 mm, jerk {} mm/s³",
                 a.jerk
-            ),
-            seed002_path::blocks(a.lsb),
-            Some(seed002_path::limits(a.jerk)),
-            seed002_path::events(),
-        ),
+            );
+            (name, blocks, Some(own), events)
+        }
     };
     let (run, format, mismatches) = if on_board {
         board_run(&a, &blocks, &axes, own, &events)

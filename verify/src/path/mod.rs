@@ -346,7 +346,11 @@ mod tests {
             to: vec![1000, 0],
         });
         assert_eq!(line.distance(&[500.0, 3.0]), 3.0);
-        assert_eq!(line.distance(&[1004.0, 3.0]), 5.0, "past the end: from the end");
+        assert_eq!(
+            line.distance(&[1004.0, 3.0]),
+            5.0,
+            "past the end: from the end"
+        );
         let arc = Element::Arc(Arc {
             plane: [0, 1],
             centre: [0, 0],
