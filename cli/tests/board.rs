@@ -56,10 +56,21 @@ impl Board {
 
     /// A bare protocol client, independent of `snapgen send`.
     fn ask(&self, c: Cmd, seq: u8) -> Reply {
-        let mut port = serialport::new(&self.port, 115_200)
-            .timeout(Duration::from_millis(20))
-            .open()
-            .unwrap();
+        // The port's exclusive lock can still be held for a moment by the last request's
+        // handle on a loaded machine: a few tries.
+        let open = || {
+            serialport::new(&self.port, 115_200)
+                .timeout(Duration::from_millis(20))
+                .open()
+        };
+        let mut port = (0..50)
+            .find_map(|_| {
+                open().ok().or_else(|| {
+                    std::thread::sleep(Duration::from_millis(20));
+                    None
+                })
+            })
+            .unwrap_or_else(|| open().unwrap());
         port.write_all(&c.to_frame(seq, &DEFAULT_FORMAT).to_bytes())
             .unwrap();
         let mut d = Decoder::new();

@@ -8,9 +8,8 @@
 //! velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read
 //! or play.
 //!
-//! Not built yet (issue 22): corners with a blend, the N-axis fabric, `--board fabric` and
-//! `--port` (the path runs on the host axis's own timeline, each change at the tick it is due);
-//! the picture does not draw the measured deviation.
+//! `--board model|fabric` and `--port` run the path length on a board (its Ts read from it),
+//! the host interpolating. Not built yet (issue 22): corners with a blend, the N-axis fabric.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -22,6 +21,7 @@ use snapgen_host::gcode::{read, Block};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::PlayError as ScriptError;
 use snapgen_host::path::board::{play_on_board, BoardError};
+use snapgen_host::path::group::MAX_EVENT_MS;
 use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::Session;
@@ -102,13 +102,15 @@ pub struct CheckFailed;
 
 /// `K@MS` as (K, MS).
 fn parse_override(s: &str) -> Result<(f64, f64), String> {
-    let bad = || format!("{s}: give K@MS, a factor 0–2 and a time in ms (e.g. 0.5@1200)");
+    let bad = || {
+        format!("{s}: give K@MS, a factor 0–2 and a time of 0–{MAX_EVENT_MS} ms (e.g. 0.5@1200)")
+    };
     let (k, ms) = s.split_once('@').ok_or_else(bad)?;
     let (k, ms): (f64, f64) = (
         k.trim().parse().map_err(|_| bad())?,
         ms.trim().parse().map_err(|_| bad())?,
     );
-    if !((0.0..=2.0).contains(&k) && ms.is_finite() && ms >= 0.0) {
+    if !((0.0..=2.0).contains(&k) && (0.0..=MAX_EVENT_MS).contains(&ms)) {
         return Err(bad());
     }
     Ok((k, ms))

@@ -127,8 +127,12 @@ impl HostAxis {
         // (Or a replan that turns back where the plan did not: the planner's realisation of a
         // stop, or of a move's end, from some states in a final brake swings back by a few
         // raw units.)
+        // Only for a move to a position in its final brake: elsewhere (a stop early in a move,
+        // a velocity) the change is made as planned.
+        let braking = matches!(p.goal, Goal::Position { .. }) && self.slows_to_its_end(p, at);
         let turns = |c: &Change| {
-            self.reverses(&c.timeline, p.command, at)
+            braking
+                && self.reverses(&c.timeline, p.command, at)
                 && !self.reverses(&self.timeline, p.command, at)
         };
         // (Not a stop on the path: a paused move is replanned whole when the override rises.)

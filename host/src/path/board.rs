@@ -37,12 +37,19 @@ pub enum BoardError {
 
 /// The driver's script for the group's `events`: each element entering is its moves (at the
 /// event's time, or once the register has reached its length), each override an override.
-/// Returns the script and, for each path event, its first script event (None: nothing to
-/// give, an element not in the program or already entered).
+/// Returns the script and, for each path event, its first script event (None: not taken, as
+/// [`Group::play`] does not take it: an element not in the program or already entered, a
+/// time past `MAX_EVENT_MS`, a length that is not a finite number ≥ 0). On a board an event
+/// whose length is never reached holds the ones after it (the driver takes events in order)
+/// until the run ends.
 fn script(g: &mut Group, events: &[PathEvent]) -> (Vec<Event>, Vec<Option<usize>>) {
     let mut out = Vec::new();
     let mut first = Vec::new();
     for e in events {
+        if !g.takes(e) {
+            first.push(None);
+            continue;
+        }
         let at_position = e.at_length.map(|l| g.position_of(l));
         let actions: Vec<Action> = match e.action {
             PathAction::Enter(k) => g.moves_for(k).into_iter().map(Action::Command).collect(),
@@ -73,7 +80,7 @@ pub fn play_on_board<L: Link>(
     let at = session
         .state()
         .map_err(|e| BoardError::State(e.to_string()))?;
-    let mut g = Group::new(blocks, axes, own, &format)?.on_board(at.x);
+    let mut g = Group::new(blocks, axes, own, &format)?.on_board(at.x)?;
     let (driver_events, first) = script(&mut g, events);
     let opts = PlayOptions {
         order: OnlineOrder::Three,

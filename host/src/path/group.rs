@@ -105,6 +105,8 @@ pub struct Group<'a> {
     moves: Vec<Ahead>,
     /// The output cell `s` starts in (0 here; a board's position register where it stands).
     origin_cell: i128,
+    /// The path's length (units), a cell per element added.
+    total: f64,
     /// The axis on `s`.
     pub axis: HostAxis,
     /// Overrides refused (event index, why).
@@ -288,6 +290,7 @@ impl<'a> Group<'a> {
             commands: Vec::new(),
             moves: Vec::new(),
             origin_cell: 0,
+            total,
             axis: HostAxis::new(settings, 0, origin),
             refused: Vec::new(),
             taken: Vec::new(),
@@ -537,17 +540,26 @@ impl<'a> Group<'a> {
         }
     }
 
+    /// Whether event `e` can be taken: an element of the program not yet entered, a time from
+    /// 0 to [`MAX_EVENT_MS`], a length (when given) that is a finite number ≥ 0.
+    pub fn takes(&self, e: &PathEvent) -> bool {
+        let known = match e.action {
+            PathAction::Enter(k) => k < self.legs.len() && k >= self.entries.len(),
+            PathAction::Override(k) => k.is_finite(),
+        };
+        known
+            && e.at_ms.is_finite()
+            && (0.0..=MAX_EVENT_MS).contains(&e.at_ms)
+            && e.at_length.is_none_or(|l| l.is_finite() && l >= 0.0)
+    }
+
     /// Plays `events` in order (each at its time, or later when its length is reached),
     /// then until the path has come to rest.
     pub fn play(&mut self, events: &[PathEvent]) {
         let ts = self.format.ts;
         let mut now = 0u64;
         for (i, e) in events.iter().enumerate() {
-            let known = match e.action {
-                PathAction::Enter(k) => k < self.legs.len(),
-                PathAction::Override(_) => true,
-            };
-            if !(known && e.at_ms.is_finite() && (0.0..=MAX_EVENT_MS).contains(&e.at_ms)) {
+            if !self.takes(e) {
                 self.taken.push(None);
                 continue;
             }
@@ -643,10 +655,21 @@ impl<'a> Group<'a> {
         self.origin_cell as f64 * self.format.position_lsb + length
     }
 
-    /// The group for a board whose position register (`s`) stands at `x` (raw) at rest.
-    pub fn on_board(mut self, x: i128) -> Self {
+    /// The group for a board whose position register (`s`) stands at `x` (raw) at rest: the
+    /// path must fit the register from there (else [`PlayError::TooLong`], before anything
+    /// moves).
+    pub fn on_board(mut self, x: i128) -> Result<Self, PlayError> {
         self.origin_cell = x >> FRAC_BITS;
-        self
+        let most = self.format.physical_max(Quantity::Position) * 0.5;
+        let from = (self.origin_cell as f64 * self.format.position_lsb).abs();
+        if from + self.total > most {
+            return Err(PlayError::TooLong {
+                line: self.legs.last().map_or(0, |b| b.line),
+                length: from + self.total,
+                most,
+            });
+        }
+        Ok(self)
     }
 }
 

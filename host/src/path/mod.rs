@@ -90,7 +90,8 @@ pub struct Run {
     pub trace: Vec<Vec<i128>>,
     /// The path length on every tick (raw `s`, from the start's cell centre).
     pub lengths: Vec<i128>,
-    /// The tick each event was taken on (None: its length was never reached).
+    /// The tick each event was taken on, from the start (None: not taken: its length never
+    /// reached, or an event the group does not take, `Group::takes`).
     pub taken: Vec<Option<u64>>,
     /// Overrides refused (event index, why).
     pub refused: Vec<(usize, AxisErrorId)>,
