@@ -127,11 +127,16 @@ impl HostAxis {
         // (Or a replan that turns back where the plan did not: the planner's realisation of a
         // stop, or of a move's end, from some states in a final brake swings back by a few
         // raw units.)
-        // Only for a move to a position in its final brake: elsewhere (a stop early in a move,
-        // a velocity) the change is made as planned.
+        // At override 0 only for a move to a position in its final brake, or one the stop
+        // ends on its target anyway: elsewhere (a stop early in a move, a velocity) the stop
+        // is made as planned. A raised or lowered override may always wait for the next move.
         let braking = matches!(p.goal, Goal::Position { .. }) && self.slows_to_its_end(p, at);
         let turns = |c: &Change| {
-            braking
+            let on_target = k == 0.0
+                && c.notes
+                    .iter()
+                    .any(|(n, note)| *n == p.command && note == STOPPED_ON_TARGET);
+            (k > 0.0 || braking || on_target)
                 && self.reverses(&c.timeline, p.command, at)
                 && !self.reverses(&self.timeline, p.command, at)
         };

@@ -119,13 +119,10 @@ pub enum MotionCommand {
 pub struct OnPath {
     /// Along the element (the geometry's limit: the feed override is cut to it).
     pub velocity: f64,
-    /// At its start, the speed a blend into it aims at: its junction's, lowered by the
+    /// At its start, the fastest a blend into it passes: its junction's (a curvature jump or a
+    /// small kink at speed costs a jerk there: `snapgen_plan::path::junction`), lowered by the
     /// look-ahead so that the path can still brake where it must.
     pub entry: f64,
-    /// At its start, the most its junction with the element before allows (a curvature jump
-    /// or a small kink at speed costs a jerk there: `snapgen_plan::path::junction`); a blend
-    /// that cannot slow to `entry` in time passes at up to this, never faster.
-    pub junction: f64,
 }
 
 impl MotionCommand {

@@ -73,10 +73,10 @@ pub(super) fn check_inputs(c: &MotionCommand, f: &Format) -> Result<(), AxisErro
             positive("jerk", jerk)?;
             if let Some(p) = path {
                 positive("path velocity", p.velocity)?;
-                if !(p.entry >= 0.0 && p.junction >= p.entry && p.junction.is_finite()) {
+                if !(p.entry.is_finite() && p.entry >= 0.0) {
                     return Err(AxisErrorId::InvalidInput(format!(
-                        "MC_MoveAbsolute path entry = {}, junction = {}: give finite speeds with 0 ≤ entry ≤ junction",
-                        p.entry, p.junction
+                        "MC_MoveAbsolute path entry = {}: give a finite speed ≥ 0",
+                        p.entry
                     )));
                 }
             }
@@ -117,6 +117,24 @@ type Planned = (Program, ChainState, Goal, bool, Option<String>);
 pub const STOPPED_ON_TARGET: &str =
     "override 0 too near the target to stop before it: stopped on it";
 
+/// The shares of a stop's deceleration tried, in turn, when the planner's stop swings back.
+const GENTLER: [f64; 4] = [0.99, 0.97, 0.93, 0.85];
+
+/// True when `program` from `from` moves against `from`'s velocity at a segment's end or
+/// middle.
+fn turns_back(from: &ChainState, program: &Program, f: &Format) -> bool {
+    let dir = from.v.signum();
+    let mut tick = 0u64;
+    dir != 0
+        && program.segments.iter().any(|s| {
+            let half = tick + u64::from(s.ticks) / 2;
+            tick += u64::from(s.ticks);
+            [half, tick]
+                .iter()
+                .any(|&t| from.after_ticks(program, t, &f.widths).v * dir < 0)
+        })
+}
+
 /// The note of a move on a path whose stop (override 0) would have come to rest past its
 /// end: it passes on into the next element, which stops on its path.
 pub(super) const PASSED_ON: &str =
@@ -145,10 +163,24 @@ pub(super) fn plan_part(
             let hold = Program {
                 segments: vec![Segment { ticks: 1, snap: 0 }],
             };
-            Ok((hold, *from))
-        } else {
-            run(OnlineTarget::Velocity(0.0), l)
+            return Ok((hold, *from));
         }
+        // The planner's exact stop swings back by a few raw units from some states: a
+        // slightly gentler deceleration, when one does not.
+        let first = run(OnlineTarget::Velocity(0.0), l)?;
+        if !turns_back(from, &first.0, f) {
+            return Ok(first);
+        }
+        let gentler = GENTLER.iter().find_map(|&share| {
+            let l = OnlineLimits {
+                deceleration: l.deceleration * share,
+                ..l
+            };
+            run(OnlineTarget::Velocity(0.0), l)
+                .ok()
+                .filter(|(p, _)| !turns_back(from, p, f))
+        });
+        Ok(gentler.unwrap_or(first))
     };
     match *cmd {
         MotionCommand::Halt { deceleration, jerk } => {
@@ -223,7 +255,7 @@ pub(super) fn plan_part(
                 // speed), and the next move stops on its path.
                 let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
                 if path.is_some() && vb != 0.0 {
-                    let most = blend_cap(path, next, false).min(vb.abs());
+                    let most = blend_cap(path, next).min(vb.abs());
                     let through = PASS_THROUGH.iter().find_map(|&share| {
                         let v = most * share * vb.signum();
                         let l = OnlineLimits {
@@ -254,7 +286,7 @@ pub(super) fn plan_part(
             let vb = next.map_or(0.0, |n| blend_velocity(cell - here, cell, velocity, n, f));
             // On a path, the element's geometry caps the set speed and the junction's the
             // blend, whatever the override (and a blend is never passed faster: below).
-            let (aim, junction) = (blend_cap(path, next, false), blend_cap(path, next, true));
+            let aim = blend_cap(path, next);
             let l = scaled(l, k);
             let l = OnlineLimits {
                 velocity: path.map_or(l.velocity, |p| l.velocity.min(p.velocity)),
@@ -350,8 +382,10 @@ pub(super) fn plan_part(
                             }
                         }
                     }
-                    // Never faster than the junction allows.
-                    match found.filter(|(v, _)| *v <= junction) {
+                    // On a path, never faster than the next element's entry speed (its
+                    // junction's, and what the look-ahead lets it brake from): else as buffered,
+                    // which the axis turns into the previous plan when it would overshoot.
+                    match found.filter(|(v, _)| *v <= aim) {
                         Some((v, r)) => {
                             Ok(passed(v, r, "too fast to slow to it by the blend point"))
                         }
@@ -370,14 +404,13 @@ pub(super) fn plan_part(
 const PASS_THROUGH: [f64; 8] = [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0];
 
 /// The shares of a blend velocity tried, in turn, when a move on a path can pass its blend
-/// point neither at it (no exact program does) nor faster within its junction's limit.
+/// point at it (no exact program does).
 const SLOWER: [f64; 8] = [0.995, 0.98, 0.95, 0.9, 0.8, 0.65, 0.5, 0.3];
 
 /// The fastest a move on a path (`path`) passes its end with `next` blending into it: the
 /// smaller element's speed limit and the next one's entry speed (its junction's, lowered by
-/// the look-ahead), or with `hard` its junction's own limit (what a blend that cannot slow to
-/// the entry speed in time may pass at instead); unbounded off a path.
-fn blend_cap(path: Option<OnPath>, next: Option<&MotionCommand>, hard: bool) -> f64 {
+/// the look-ahead); unbounded off a path.
+fn blend_cap(path: Option<OnPath>, next: Option<&MotionCommand>) -> f64 {
     let next = match next {
         Some(MotionCommand::MoveAbsolute { path, .. }) => *path,
         _ => None,
@@ -385,7 +418,7 @@ fn blend_cap(path: Option<OnPath>, next: Option<&MotionCommand>, hard: bool) -> 
     [
         path.map(|p| p.velocity),
         next.map(|p| p.velocity),
-        next.map(|p| if hard { p.junction } else { p.entry }),
+        next.map(|p| p.entry),
     ]
     .into_iter()
     .flatten()

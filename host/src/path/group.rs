@@ -512,7 +512,6 @@ impl<'a> Group<'a> {
                 path: Some(OnPath {
                     velocity: m.cap,
                     entry,
-                    junction: m.junction.max(entry),
                 }),
             };
             let c = self.moves.len();
