@@ -4,7 +4,7 @@
 use snapgen_model::format::Quantity;
 use snapgen_plan::online::OnlineError;
 
-use super::part::{check_inputs, plan_part, prefix, PASSED_ON, STOPPED_ON_TARGET};
+use super::part::{check_inputs, checkpoints, plan_part, prefix, PASSED_ON, STOPPED_ON_TARGET};
 use super::{
     AxisErrorId, BufferMode, Change, Goal, HostAxis, MotionCommand, Outcome, Part, Timeline,
 };
@@ -241,19 +241,8 @@ impl HostAxis {
                 .iter()
                 .filter(|q| q.command == command && q.end_tick() > at)
                 .any(|q| {
-                    let mut tick = q.start_tick;
-                    q.program.segments.iter().any(|s| {
-                        let half = tick + u64::from(s.ticks) / 2;
-                        tick += u64::from(s.ticks);
-                        [half, tick].iter().any(|&t| {
-                            t > at
-                                && q.start
-                                    .after_ticks(&q.program, t - q.start_tick, &f.widths)
-                                    .v
-                                    * dir
-                                    < 0
-                        })
-                    })
+                    let after = i128::from(at) - i128::from(q.start_tick);
+                    checkpoints(&q.start, &q.program, after, f).any(|s| s.v * dir < 0)
                 })
     }
 
@@ -276,21 +265,9 @@ impl HostAxis {
                     self.timeline.state_at(at, f).x
                 };
                 let dir = (cell - f.output_lsb(x)).signum();
-                let mut tick = q.start_tick;
-                q.program.segments.iter().any(|s| {
-                    let half = tick + u64::from(s.ticks) / 2;
-                    tick += u64::from(s.ticks);
-                    [half, tick].iter().any(|&t| {
-                        t > from
-                            && (f.output_lsb(
-                                q.start
-                                    .after_ticks(&q.program, t - q.start_tick, &f.widths)
-                                    .x,
-                            ) - cell)
-                                * dir
-                                > 0
-                    })
-                })
+                let after = i128::from(from) - i128::from(q.start_tick);
+                checkpoints(&q.start, &q.program, after, f)
+                    .any(|s| (f.output_lsb(s.x) - cell) * dir > 0)
             })
     }
 

@@ -120,19 +120,33 @@ pub const STOPPED_ON_TARGET: &str =
 /// The shares of a stop's deceleration tried, in turn, when the planner's stop swings back.
 const GENTLER: [f64; 4] = [0.99, 0.97, 0.93, 0.85];
 
+/// The states `program` from `start` passes at every segment's middle and end, those after
+/// tick `after` (relative to `start`; may be negative): where the host judges a plan's
+/// direction (the acceleration is linear within a segment at orders 2 and 3).
+pub(super) fn checkpoints<'a>(
+    start: &'a ChainState,
+    program: &'a Program,
+    after: i128,
+    f: &'a Format,
+) -> impl Iterator<Item = ChainState> + 'a {
+    let mut tick = 0u64;
+    program
+        .segments
+        .iter()
+        .flat_map(move |s| {
+            let half = tick + u64::from(s.ticks) / 2;
+            tick += u64::from(s.ticks);
+            [half, tick]
+        })
+        .filter(move |&t| i128::from(t) > after)
+        .map(move |t| start.after_ticks(program, t, &f.widths))
+}
+
 /// True when `program` from `from` moves against `from`'s velocity at a segment's end or
 /// middle.
 fn turns_back(from: &ChainState, program: &Program, f: &Format) -> bool {
     let dir = from.v.signum();
-    let mut tick = 0u64;
-    dir != 0
-        && program.segments.iter().any(|s| {
-            let half = tick + u64::from(s.ticks) / 2;
-            tick += u64::from(s.ticks);
-            [half, tick]
-                .iter()
-                .any(|&t| from.after_ticks(program, t, &f.widths).v * dir < 0)
-        })
+    dir != 0 && checkpoints(from, program, -1, f).any(|s| s.v * dir < 0)
 }
 
 /// The note of a move on a path whose stop (override 0) would have come to rest past its
