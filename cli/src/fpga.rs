@@ -263,7 +263,13 @@ pub struct BoardSynth {
     pub full: crate::yosys::SynthReport,
     /// Motion core alone (with its stop unit, a block of its own in synthesis).
     pub core: crate::yosys::SynthReport,
+    /// The path interpolator for [`INTERPOLATOR_AXES`] axes, on its own (issue 22: not yet
+    /// part of the board's design).
+    pub interpolator: crate::yosys::SynthReport,
 }
+
+/// Axes of the path interpolator `snapgen synth` reports (issue 22's target: at least 4).
+pub const INTERPOLATOR_AXES: u8 = 4;
 
 /// The motion core's module, and its stop unit's (kept apart in synthesis).
 const CORE_MODULE: &str = snapgen_hdl::verilog::CORE_PREFIX;
@@ -334,7 +340,7 @@ impl BoardSynth {
         format!(
             "Yosys synth_xilinx -family {} for the {} ({}: {}, package {}, speed grade {}):\n\n\
              | design | LUT | FF | CARRY4 | DSP48E1 | LUT-RAM cells | BRAM36 | logic-only path (ns) |\n\
-             |---|---|---|---|---|---|---|---|\n{}{}{}\n\
+             |---|---|---|---|---|---|---|---|\n{}{}{}{}\n\
              Logic-only path: Yosys `sta` with the Xilinx cell library's specify blocks; routing is\n\
              not included. Motion core budget: ≤ {CORE_LUT_BUDGET} LUT, ≤ {CORE_FF_BUDGET} FF,\n\
              ≤ {CORE_PATH_BUDGET_NS} ns (its program memory is the LUT-RAM, reported apart; its\n\
@@ -360,6 +366,13 @@ impl BoardSynth {
                 &stop.resources,
                 stop.path_ns
             ),
+            row(
+                &format!(
+                    "path interpolator for {INTERPOLATOR_AXES} axes, on its own (issue 22; not yet in the design)"
+                ),
+                &self.interpolator.resources,
+                self.interpolator.path_ns
+            ),
         )
     }
 }
@@ -381,10 +394,19 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
         &b.family,
     )?;
     let core = crate::yosys::synth(&[core_file], snapgen_hdl::verilog::CORE_PREFIX, &b.family)?;
+    let prefix = snapgen_hdl::interpolator::INTERPOLATOR_PREFIX;
+    let file = dir.join(format!("{prefix}.v"));
+    std::fs::write(
+        &file,
+        snapgen_hdl::interpolator::interpolator_verilog(INTERPOLATOR_AXES),
+    )
+    .with_context(|| format!("cannot write {}", file.display()))?;
+    let interpolator = crate::yosys::synth(&[file], prefix, &b.family)?;
     let _ = std::fs::remove_dir_all(&dir);
     Ok(BoardSynth {
         board: b.clone(),
         full,
         core,
+        interpolator,
     })
 }

@@ -52,6 +52,10 @@ enum Command {
     /// switches, emergency stop) against the device model, every output on every clock, under
     /// random command streams; exit 1 on any mismatch (the waves around it are written).
     CosimIo(cosim_io::Args),
+    /// Co-simulate the path interpolator (issue 22: a distance into a line or arc becomes
+    /// each axis's position) against its model, every output on every clock, under random
+    /// segments from the path planner; exit 1 on any mismatch.
+    CosimInterp(cosim_interp::Args),
     /// Play a timed script of PLCopen commands (MC_MoveAbsolute with its buffer modes,
     /// MC_MoveVelocity, MC_Halt, the feed override) through the host axis on a board: every
     /// change planned from the exact state at a swap tick ahead of the link's latency and
@@ -107,6 +111,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Spec(a) => spec::run(a),
         Command::Cosim(a) => cosim::run(a),
         Command::CosimIo(a) => cosim_io::run(a),
+        Command::CosimInterp(a) => cosim_interp::run(a),
         Command::Online(a) => online::run(a),
         Command::Send(a) => send::run(a),
         Command::Stop(a) => stop::run(a),

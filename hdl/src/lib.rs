@@ -29,6 +29,7 @@ pub mod emit;
 pub mod executor;
 pub mod frame_rx;
 pub mod input_filter;
+pub mod interpolator;
 pub mod io_top;
 pub mod netlist;
 pub mod payload_shift;

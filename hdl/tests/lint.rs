@@ -83,6 +83,14 @@ fn every_block_lints_clean() {
         snapgen_hdl::io_top::IoTop::default(),
         &snapgen_hdl::verilog::io_top_waivers(),
     );
+    // The interpolator at the smallest, an odd and the largest number of axes.
+    for axes in [1, 3, 8] {
+        lint(
+            "interpolator",
+            snapgen_hdl::interpolator::Interpolator::new(axes),
+            &[],
+        );
+    }
 }
 
 /// The files `snapgen verilog` writes: `snapgen_io.v` instantiates `snapgen_core` (no module

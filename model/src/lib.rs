@@ -34,7 +34,10 @@ pub use chain::{ChainState, Sequencer, TickSample, Trace};
 pub use core::CoreModel;
 pub use error::{FormatError, ProgramError};
 pub use format::{Format, PositionFix, Quantity, RegisterRange, Widths, DEFAULT_FORMAT, FRAC_BITS};
-pub use ports::{CoreCommand, CoreInputs, CoreOutputs, CoreStatus, IoInputs, IoOutputs};
+pub use ports::{
+    CoreCommand, CoreInputs, CoreOutputs, CoreStatus, InterpInputs, InterpOutputs, IoInputs,
+    IoOutputs,
+};
 pub use program::{Program, Segment, SnapTimeline};
 
 /// Facts of the design that the contract's prose names and the spec does not know: the

@@ -7,6 +7,8 @@
 //!   its `status` section (what the executor reads).
 //! * [`IoInputs`], [`IoOutputs`]: the I/O top's pins (`snapgen_io`) for one clock, the status
 //!   block as a [`snapgen_spec::Status`].
+//! * [`InterpInputs`], [`InterpOutputs`]: the path interpolator (`snapgen_interpolator`,
+//!   [`crate::path::engine`]) for one clock.
 
 /// A block's inputs and outputs as two structs.
 macro_rules! port_structs {
@@ -34,6 +36,9 @@ snapgen_spec::with_motion_core_ports!(
     port_structs! { CoreInputs, CoreOutputs, "the motion core"; }
 );
 snapgen_spec::with_io_top_ports!(port_structs! { IoInputs, IoOutputs, "the I/O top"; });
+snapgen_spec::with_interpolator_ports!(port_structs! {
+    InterpInputs, InterpOutputs, "the path interpolator";
+});
 
 /// The core's `command` inputs and `status` outputs as structs of their own.
 macro_rules! core_sections {

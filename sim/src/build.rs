@@ -144,6 +144,19 @@ pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
     )
 }
 
+/// Builds (or finds in the cache) the library of the path interpolator for `axes` axes
+/// ([`crate::interp`]), with VCD tracing if `trace`.
+pub fn build_interpolator(axes: u8, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "interp",
+        snapgen_hdl::interpolator::INTERPOLATOR_PREFIX,
+        &snapgen_hdl::interpolator::interpolator_verilog(axes),
+        HARNESS_CPP,
+        &crate::interp::interp_layout_header(),
+        trace,
+    )
+}
+
 /// Builds `verilog` (top module `top_module`, written to `TOP_MODULE.v`) with `harness` and its
 /// generated word layout `layout` (`snapgen_layout.h`); the C++ class is `Vtop` whatever the
 /// top module is called.

@@ -11,6 +11,7 @@
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
 //! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
 //!   model under random command streams; [`board`] is the virtual board on it.
+//! * [`interp`] runs the path interpolator in lockstep with its model (issue 22).
 
 pub mod board;
 pub mod build;
@@ -18,6 +19,7 @@ pub mod closed_loop;
 pub mod cosim;
 pub mod fabric;
 pub mod host_link;
+pub mod interp;
 pub mod io;
 pub mod io_cosim;
 pub mod layout;
@@ -62,7 +64,7 @@ pub enum SimError {
     /// A deliberate fault (test hook) was asked for at a clock its session never reached.
     #[error(
         "the fault at clock {clock} was never injected: session 0 ran only {clocks} clocks; \
-         pick an earlier clock, more moves or fewer sessions"
+         pick an earlier clock or a longer run (more moves, more clocks, fewer sessions)"
     )]
     FaultNotReached {
         /// The clock asked for.

@@ -196,6 +196,57 @@ macro_rules! with_io_top_ports {
     };
 }
 
+/// Calls `$callback! { $($extra)* <the path interpolator's ports> }` (see the module
+/// documentation): the block that maps a distance into a path segment onto every axis
+/// (`snapgen_model::path::engine`, issue 22). Values are raw, in the chain's position format.
+#[macro_export]
+macro_rules! with_interpolator_ports {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            clock: "Fabric clock.";
+            inputs {
+                reset {
+                    reset: bit[1] bool, "Synchronous reset, active high: the interpolator goes idle (the loaded segment stays).";
+                }
+                shape {
+                    load_shape: bit[1] bool, "Load the segment's shape from the ports below (any clock; a computation running reads the shape as it is on each clock).";
+                    arc: bit[1] bool, "The segment is an arc (or a helix); otherwise a line.";
+                    ccw: bit[1] bool, "The arc turns counter-clockwise from `plane_first` toward `plane_second`.";
+                    plane_first: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's first axis.";
+                    plane_second: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's second axis.";
+                    centre_first: bits[$crate::widths::X_BITS] i128, "The arc's centre on the first plane axis, raw.";
+                    centre_second: bits[$crate::widths::X_BITS] i128, "The arc's centre on the second plane axis, raw.";
+                    radius: bits[$crate::widths::X_BITS] i128, "The arc's radius at its start, raw.";
+                    growth: bits[$crate::widths::SHARE_BITS] i128, "The radius's change per raw unit of the path length (62 fraction bits, signed).";
+                    start_angle: bits[$crate::widths::TURN_BITS] u64, "The arc's angle at its start (a turn is 2^64).";
+                    rate: bits[$crate::widths::RATE_BITS] i128, "The arc's turns·2^64 per raw unit of the path length, 120 fraction bits (≥ 0).";
+                }
+                axis {
+                    load_axis: bit[1] bool, "Load axis `axis`'s start and share from the ports below (any clock).";
+                    axis: bits[$crate::widths::AXIS_BITS] u8, "The axis to load.";
+                    from: bits[$crate::widths::X_BITS] i128, "The axis at the segment's start, raw.";
+                    share: bits[$crate::widths::SHARE_BITS] i128, "The axis's share of the length, `Δx / length` (62 fraction bits, signed; 0 on an arc's plane axes).";
+                }
+                command {
+                    start: bit[1] bool, "Compute every axis at `offset` (one-clock pulse; ignored while busy).";
+                    offset: bits[$crate::widths::X_BITS] i128, "The distance into the segment, raw (the path length minus the segment's start).";
+                }
+            }
+            outputs {
+                status {
+                    busy: bit[1] bool, "A computation runs.";
+                    done: bit[1] bool, "The computation ended on the last clock (one clock wide, with the last axis's write).";
+                }
+                result {
+                    out_write: bit[1] bool, "`out_value` is axis `out_axis`'s position (one clock wide, once per axis and computation).";
+                    out_axis: bits[$crate::widths::AXIS_BITS] u8, "The axis written.";
+                    out_value: bits[$crate::widths::X_BITS] i128, "Its position, raw (the chain's position format).";
+                }
+            }
+        }
+    };
+}
+
 /// Builds a [`Block`] table from a port list.
 macro_rules! block_table {
     (
@@ -217,6 +268,9 @@ macro_rules! block_table {
 
 with_motion_core_ports!(block_table! { MOTION_CORE, "the motion core (`snapgen_core`)"; });
 with_io_top_ports!(block_table! { IO_TOP, "the I/O top (`snapgen_io`)"; });
+with_interpolator_ports!(
+    block_table! { INTERPOLATOR, "the path interpolator (`snapgen_interpolator`)"; }
+);
 
 /// What a board pin is wired to in the board top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -325,7 +379,7 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_sections_known() {
-        for b in [MOTION_CORE, IO_TOP] {
+        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR] {
             let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
             names.push(b.clock);
             let n = names.len();

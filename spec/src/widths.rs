@@ -40,6 +40,23 @@ pub const GAIN_BITS: u32 = 48;
 /// Fractional bits of the controller's following error (counts · 2^-E_FRAC).
 pub const E_FRAC: u32 = 16;
 
+/// Axes a path design may have at most (issue 22: 1 to 8, chosen at generation).
+pub const MAX_AXES: u32 = 8;
+/// Width of an axis index in the path interpolator.
+pub const AXIS_BITS: u32 = 3;
+/// Width of a line's share of the length per axis, an arc's radius growth and the
+/// interpolator's sine and cosine (signed, 62 fraction bits: `1.0` is `2^62`).
+pub const SHARE_BITS: u32 = 64;
+/// Fraction bits of a share, a growth, a sine or a cosine.
+pub const SHARE_FRAC: u32 = 62;
+/// Width of an arc's angular rate (turns·2^64 per raw unit of the path length, with
+/// [`RATE_FRAC`] fraction bits; never negative).
+pub const RATE_BITS: u32 = 128;
+/// Fraction bits of an arc's angular rate.
+pub const RATE_FRAC: u32 = 120;
+/// Width of an angle: a full turn is `2^TURN_BITS`.
+pub const TURN_BITS: u32 = 64;
+
 /// Bytes that hold `bits` bits.
 pub const fn bytes_for(bits: u32) -> usize {
     bits.div_ceil(8) as usize
@@ -55,6 +72,7 @@ const _: () = {
     assert!(V_BITS == A_BITS && A_BITS == J_BITS && J_BITS == D_BITS);
     assert!(X_BITS > V_BITS && X_BITS <= 127 && X_BITS >= FRAC_BITS + POSITION_BITS);
     assert!(bytes_for(V_BITS) == WIDE_BYTES);
+    assert!(MAX_AXES == 1 << AXIS_BITS);
 };
 
 /// The largest value of a register of `bits` bits: two's complement when `signed`.

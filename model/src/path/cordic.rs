@@ -34,7 +34,7 @@ use ethnum::{I256, U256};
 pub struct Turn(pub u64);
 
 /// Fraction bits of the results (`1.0` is `2⁶²`).
-pub const ONE_BITS: u32 = 62;
+pub const ONE_BITS: u32 = snapgen_spec::widths::SHARE_FRAC;
 /// CORDIC steps.
 pub const ITERATIONS: usize = 62;
 /// The error the tests allow [`cos_sin`], in units of `2⁻⁶²` (measured: at most 11 at the

@@ -23,7 +23,7 @@ use ethnum::I256;
 use super::cordic::{cos_sin, Turn, ONE_BITS};
 
 /// Fraction bits of an arc's angular rate (turns·2⁶⁴ per raw unit of `s`).
-pub const RATE_SHIFT: u32 = 120;
+pub const RATE_SHIFT: u32 = snapgen_spec::widths::RATE_FRAC;
 
 /// How a segment maps its length onto the axes.
 #[derive(Clone, Debug, PartialEq, Eq)]

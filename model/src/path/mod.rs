@@ -1,9 +1,11 @@
 //! Several axes along one path (seed 002's Cartesian path following): the rules by which a
 //! path length `s`, integrated by the chain, becomes each axis's position.
 //!
-//! Built so far: [`interp`], the interpolator's rules for lines, arcs and helices, and
-//! [`cordic`], the integer sine and cosine it uses. The path sequencer, the group stop and the
-//! fabric are not built yet (issue 22).
+//! Built so far: [`interp`], the interpolator's rules for lines, arcs and helices,
+//! [`cordic`], the integer sine and cosine it uses, and [`engine`], the fabric's interpolator
+//! clock by clock. The path sequencer, the group stop and the N-axis fabric are not built yet
+//! (issue 22).
 
 pub mod cordic;
+pub mod engine;
 pub mod interp;

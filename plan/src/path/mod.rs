@@ -303,6 +303,13 @@ fn fit_rules(start: &[i64], drafts: &[Draft], bounds: &[i128], axes: usize) -> P
     for (k, d) in drafts.iter().enumerate() {
         let length = (bounds[k + 1] - bounds[k]).max(1);
         let shape = match d {
+            // A repeated point (an element of length 0): the axes are already in its cell
+            // (where the element before ended); they hold. (Else the rounding of that end
+            // over one unit of s would be a share of 2^90 and more: beyond the fabric's port.)
+            Draft::Line { .. } if bounds[k + 1] == bounds[k] => Shape::Line {
+                dir: vec![0; axes],
+                from: from.clone(),
+            },
             Draft::Line { to } => Shape::Line {
                 dir: from
                     .iter()
@@ -379,6 +386,29 @@ mod tests {
         let p = prepare(&[0, 0], &[Element::Line { to: vec![1, 1] }]).unwrap();
         let root2 = p.length() as f64 / 2f64.powi(FRAC_BITS as i32);
         assert!((root2 - std::f64::consts::SQRT_2).abs() < 1e-15, "{root2}");
+    }
+
+    #[test]
+    fn a_repeated_point_holds_the_axes_in_its_cell() {
+        let path = made(
+            &[0],
+            &[
+                Element::Line { to: vec![7] },
+                Element::Line { to: vec![7] },
+                Element::Line { to: vec![4] },
+            ],
+        )
+        .unwrap();
+        let one = 1i128 << ONE_BITS;
+        for g in &path.segments {
+            let Shape::Line { dir, .. } = &g.shape else {
+                panic!("lines")
+            };
+            assert!(dir.iter().all(|d| d.abs() <= one), "{g:?}");
+        }
+        let held = &path.segments[1];
+        assert_eq!(held.at(0)[0] >> FRAC_BITS, 7);
+        assert_eq!(path.at(path.length()).unwrap()[0] >> FRAC_BITS, 4);
     }
 
     #[test]

@@ -1,0 +1,163 @@
+//! The path interpolator (issue 22): a distance into the loaded path segment becomes every
+//! axis's position, one axis after the other, through one shared serial multiplier and a
+//! CORDIC (the rule: `snapgen_model::path::interp`; the reference, register for register:
+//! `snapgen_model::path::engine`, whose documentation gives the clocks a computation takes).
+//!
+//! Its ports are the spec's `with_interpolator_ports!` list. The number of axes (1 to
+//! [`MAX_AXES`]) is chosen at generation: an axis adds one word to each of two small
+//! memories and [`SHARE_BITS`]` + 1` clocks to a computation, no arithmetic.
+//!
+//! rust-hdl 0.46 has no signed shifts, memories with run-time indices inside a clocked
+//! process or functions, so this block writes its own Verilog (`hdl/verilog/interpolator.v`);
+//! for rust-hdl's simulator it runs the model's engine. The Verilog is what is checked:
+//! Verilator co-simulation against the engine on every clock (`snapgen_sim::interp`).
+//!
+//! The block is not yet part of a generated design: the path sequencer that loads segments
+//! and starts it on each tick, and the N-axis core around it, are still to be built.
+
+use rust_hdl::prelude::*;
+use snapgen_model::path::cordic::{constants, ITERATIONS};
+use snapgen_model::path::engine::{Engine, CORDIC_BITS, HI_BITS, LO_BITS};
+use snapgen_model::InterpInputs;
+use snapgen_spec::widths::{MAX_AXES, RATE_BITS, RATE_FRAC, SHARE_BITS, SHARE_FRAC};
+
+use crate::block_with_ports;
+use crate::protocol_v::LocalParam;
+use crate::sim_bits::{from_i128, to_i128, to_u128};
+use crate::template::{fill, Holes};
+
+/// The block's template.
+const TEMPLATE: &str = include_str!("../verilog/interpolator.v");
+
+/// Module prefix of the interpolator's own Verilog (`snapgen_interpolator.v`).
+pub const INTERPOLATOR_PREFIX: &str = "snapgen_interpolator";
+
+snapgen_spec::with_interpolator_ports!(block_with_ports! {
+    /// The path interpolator for a design of `axes` axes.
+    pub struct Interpolator(axes: u8) {
+        _axes: u8 = axes,
+        _sim: Engine = Engine::new(axes),
+    }
+});
+
+impl Interpolator {
+    /// The interpolator of a design of `axes` axes (1 to [`MAX_AXES`]).
+    pub fn new(axes: u8) -> Self {
+        Interpolator::build(axes)
+    }
+}
+
+impl Logic for Interpolator {
+    fn update(&mut self) {
+        if self.clock.pos_edge() {
+            let i = InterpInputs {
+                reset: self.reset.val(),
+                load_shape: self.load_shape.val(),
+                arc: self.arc.val(),
+                ccw: self.ccw.val(),
+                plane_first: self.plane_first.val().to_u64() as u8,
+                plane_second: self.plane_second.val().to_u64() as u8,
+                centre_first: to_i128(self.centre_first.val()),
+                centre_second: to_i128(self.centre_second.val()),
+                radius: to_i128(self.radius.val()),
+                growth: to_i128(self.growth.val()),
+                start_angle: self.start_angle.val().to_u64(),
+                rate: to_u128(self.rate.val()) as i128,
+                load_axis: self.load_axis.val(),
+                axis: self.axis.val().to_u64() as u8,
+                from: to_i128(self.from.val()),
+                share: to_i128(self.share.val()),
+                start: self.start.val(),
+                offset: to_i128(self.offset.val()),
+            };
+            self._sim.clock(&i);
+        }
+        let o = self._sim.outputs();
+        self.busy.next = o.busy;
+        self.done.next = o.done;
+        self.out_write.next = o.out_write;
+        self.out_axis.next = u64::from(o.out_axis).into();
+        self.out_value.next = from_i128(o.out_value);
+    }
+
+    fn connect(&mut self) {
+        self.busy.connect();
+        self.done.connect();
+        self.out_write.connect();
+        self.out_axis.connect();
+        self.out_value.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(interpolator_body(self._axes))
+    }
+}
+
+/// The arctangent ROM: one `case` entry per CORDIC step.
+fn atan_cases() -> String {
+    let c = constants();
+    let mut s = String::new();
+    for (i, a) in c.atan.iter().enumerate() {
+        s.push_str(&format!("   6'd{i}: atan = {CORDIC_BITS}'d{a};\n"));
+    }
+    s.push_str(&format!("   default: atan = {CORDIC_BITS}'d0;\n"));
+    s
+}
+
+/// The block's body for `axes` axes (the template filled, its widths in front).
+fn interpolator_body(axes: u8) -> String {
+    assert!((1..=MAX_AXES as u8).contains(&axes), "1 to {MAX_AXES} axes");
+    let holes = Holes::new()
+        .value("AXES", axes)
+        .value("AXES_TOP", axes - 1)
+        .value("LAST_STEP", ITERATIONS - 1)
+        .value("SHARE_LAST", SHARE_BITS - 1)
+        .value("RATE_LAST", RATE_BITS - 1)
+        .value("CORDIC_BITS", CORDIC_BITS)
+        .value("GAIN", constants().gain)
+        .block("atan_cases", atan_cases());
+    let body =
+        fill("interpolator.v", TEMPLATE, &holes).expect("the interpolator's template is filled");
+    let mut params = crate::protocol_v::localparams();
+    for (name, bits) in [
+        ("SHARE_BITS", SHARE_BITS),
+        ("SHARE_FRAC", SHARE_FRAC),
+        ("RATE_BITS", RATE_BITS),
+        ("RATE_FRAC", RATE_FRAC),
+        ("HI_BITS", HI_BITS),
+        ("LO_BITS", LO_BITS),
+        ("CORDIC_BITS", CORDIC_BITS),
+    ] {
+        params.push(LocalParam::new(name, 32, u64::from(bits)));
+    }
+    crate::protocol_v::with_localparams(&params, &body)
+}
+
+/// The interpolator's Verilog for `axes` axes: `snapgen_interpolator.v`, top module
+/// `snapgen_interpolator`.
+pub fn interpolator_verilog(axes: u8) -> String {
+    let header = [
+        format!(
+            "snapgen path interpolator for {axes} axes: a distance into a line or arc segment becomes each axis's position."
+        ),
+        "Reference: snapgen_model::path::engine, register for register.".to_string(),
+    ];
+    let mut uut = Interpolator::new(axes);
+    uut.connect_all();
+    crate::emit::emit(&generate_verilog(&uut), INTERPOLATOR_PREFIX, &header, &[])
+        .expect("the interpolator's names are checked by its tests")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolator_is_synthesizable() {
+        // One axis and eight: an axis costs memory words, not logic (printed for the docs).
+        for axes in [1, 8] {
+            let stat = crate::synth_check::synth_block("interpolator", Interpolator::new(axes));
+            eprintln!("{axes} axes:\n{stat}");
+        }
+    }
+}
