@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The project's test command (README, CI): installs what the tests need when it is missing
-# (scripts/setup.sh), then checks formatting and lints, runs every test, checks that the ARM64
+# (scripts/setup.sh), then checks formatting and lints, runs every test, checks routed timing
+# of the blocks that must close it on their own (scripts/route.sh), checks that the ARM64
 # host build plans bit-identically under emulation (scripts/arm64.sh) and that the crates build
 # with their rust-version (scripts/msrv.sh).
 #
@@ -23,6 +24,8 @@ cargo test --release --workspace 2>&1 | tee "$log"
 # One closing line for the whole run: the sum of every test binary's result line.
 awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i+1) ~ /^passed/) p += $i; if ($(i+1) ~ /^failed/) f += $i } }
      END { printf "%d passed, %d failed\n", p, f }' "$log"
+echo "== routed timing"
+./scripts/route.sh
 echo "== arm64 host"
 ./scripts/arm64.sh
 echo "== minimum Rust version"

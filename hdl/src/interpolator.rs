@@ -4,8 +4,10 @@
 //! `snapgen_model::path::engine`, whose documentation gives the clocks a computation takes).
 //!
 //! Its ports are the spec's `with_interpolator_ports!` list. The number of axes (1 to
-//! [`MAX_AXES`]) is chosen at generation: an axis adds one word to each of two small
-//! memories and [`SHARE_BITS`]` + 1` clocks to a computation, no arithmetic.
+//! [`MAX_AXES`]) is chosen at generation; the per-axis memories are [`MAX_AXES`] words deep
+//! whatever it is, so an axis adds [`SHARE_BITS`]` + 2` clocks to a computation and no
+//! arithmetic. Its timing (no sum wider than 58 bits in a clock) and routed Fmax:
+//! docs/PATH.md.
 //!
 //! rust-hdl 0.46 has no signed shifts, memories with run-time indices inside a clocked
 //! process or functions, so this block writes its own Verilog (`hdl/verilog/interpolator.v`);
@@ -17,7 +19,7 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::path::cordic::{constants, ITERATIONS};
-use snapgen_model::path::engine::{Engine, CORDIC_BITS, HI_BITS, LO_BITS};
+use snapgen_model::path::engine::{Engine, CORDIC_BITS, HI_BITS, LO_BITS, SPLIT, T_BITS};
 use snapgen_model::InterpInputs;
 use snapgen_spec::widths::{MAX_AXES, RATE_BITS, RATE_FRAC, SHARE_BITS, SHARE_FRAC};
 
@@ -111,8 +113,8 @@ fn interpolator_body(axes: u8) -> String {
         .value("AXES", axes)
         .value("AXES_TOP", axes - 1)
         .value("LAST_STEP", ITERATIONS - 1)
-        .value("SHARE_LAST", SHARE_BITS - 1)
-        .value("RATE_LAST", RATE_BITS - 1)
+        .value("SHARE_LAST", SHARE_BITS / 2 - 1)
+        .value("RATE_LAST", RATE_BITS / 2 - 1)
         .value("CORDIC_BITS", CORDIC_BITS)
         .value("GAIN", constants().gain)
         .block("atan_cases", atan_cases());
@@ -127,6 +129,8 @@ fn interpolator_body(axes: u8) -> String {
         ("HI_BITS", HI_BITS),
         ("LO_BITS", LO_BITS),
         ("CORDIC_BITS", CORDIC_BITS),
+        ("T_BITS", T_BITS),
+        ("SPLIT", SPLIT),
     ] {
         params.push(LocalParam::new(name, 32, u64::from(bits)));
     }

@@ -1,5 +1,7 @@
 //! `snapgen verilog`: the motion core (`snapgen_core.v`) and the I/O top (`snapgen_io.v`,
-//! which instantiates it) for a clock, baud rate and Ts.
+//! which instantiates it) for a clock, baud rate and Ts; with `--interpolator AXES` also the
+//! path interpolator (`snapgen_interpolator.v`, issue 22: a block of its own, not yet in the
+//! design).
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +18,10 @@ pub struct Args {
     out: PathBuf,
     #[command(flatten)]
     timing: TimingArgs,
+    /// Also write the path interpolator for this many axes (1 to 8) as
+    /// `snapgen_interpolator.v` (a block of its own: no design instantiates it yet).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
+    interpolator: Option<u8>,
 }
 
 /// Runs the subcommand.
@@ -34,6 +40,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         u64::from(d.dividers.tick_div) + 1,
         d.design_hash
     );
+    if let Some(axes) = a.interpolator {
+        let prefix = snapgen_hdl::interpolator::INTERPOLATOR_PREFIX;
+        let file = a.out.join(format!("{prefix}.v"));
+        std::fs::write(&file, snapgen_hdl::interpolator::interpolator_verilog(axes))
+            .with_context(|| format!("cannot write {}", file.display()))?;
+        println!("wrote {} ({axes} axes)", file.display());
+    }
     Ok(())
 }
 

@@ -6,22 +6,27 @@
 //!
 //! * a **serial multiplier**: `a · b` for a signed [`X_BITS`]-bit `a` and a signed `n`-bit `b`
 //!   (`n` = [`SHARE_BITS`] for a share, a growth, a sine or a cosine; [`RATE_BITS`] for an
-//!   arc's rate), one bit of `b` per clock from the lowest, into a right-shifting accumulator
-//!   `hi:lo` (the last bit, the sign, subtracts `a`): the exact product, so `>>` rounds toward
-//!   −∞ exactly as [`super::interp`]'s 256-bit `mul_shift`;
-//! * the **CORDIC** of [`super::cordic`], one step per clock.
+//!   arc's rate), one radix-4 Booth digit of `b` (`−2…2`, from the lowest) per two clocks into
+//!   a right-shifting accumulator `hi:lo`: the exact product, so `>>` rounds toward −∞ exactly
+//!   as [`super::interp`]'s 256-bit `mul_shift`;
+//! * the **CORDIC** of [`super::cordic`], one step per two clocks.
+//!
+//! No addition wider than [`SPLIT`]` + 1` bits happens in one clock, so the block closes routed
+//! timing (docs/PATH.md): the accumulator's [`T_BITS`]-bit sum is added low half then high half
+//! (the carry between them registered), as is each product's use (`base + product`, two
+//! clocks), and a CORDIC step shifts on one clock and adds on the next.
 //!
 //! A computation starts on `start` (while idle) with `offset`, the distance `r` into the
 //! loaded segment, and writes each axis once (`out_write`, `out_axis`, `out_value`), `done`
 //! with the last write:
 //!
 //! * **line**: for each axis `k`, `from_k + ((r · share_k) >> 62)`:
-//!   [`SHARE_BITS`]` + 1` clocks per axis after the one that takes `start`;
-//! * **arc**: the angle `start ± ((r · rate) >> 120)` ([`RATE_BITS`]` + 1` clocks), the CORDIC
-//!   (1 + [`ITERATIONS`] + 1 clocks: set up, steps, quadrant), the radius
+//!   [`SHARE_BITS`]` + 2` clocks per axis after the one that takes `start`;
+//! * **arc**: the angle `start ± ((r · rate) >> 120)` ([`RATE_BITS`]` + 2` clocks), the CORDIC
+//!   (1 + 2·[`ITERATIONS`] + 1 clocks: set up, steps, quadrant), the radius
 //!   `radius + ((r · growth) >> 62)`, the plane's axes `centre + ((ρ · cos) >> 62)` and
 //!   `centre + ((ρ · sin) >> 62)`, then the other axes as on a line (each
-//!   [`SHARE_BITS`]` + 1` clocks). [`clocks`] counts them.
+//!   [`SHARE_BITS`]` + 2` clocks). [`clocks`] counts them.
 //!
 //! Every register wraps to its fabric width. For a segment whose values fit their ports
 //! ([`load_inputs`] checks) and an offset within the segment (or a cell beyond it), the
@@ -43,13 +48,19 @@ pub const LO_BITS: u32 = RATE_BITS;
 /// Width of the CORDIC's `x`, `y` and `z` (a share and its sign: `|x|, |y| ≤ 2^62` and
 /// `|z| ≤ 2^61` on every step, tested).
 pub const CORDIC_BITS: u32 = SHARE_BITS + 1;
-/// Width of the multiplier's bit counter.
+/// Width of the multiplier's digit counter.
 pub const COUNT_BITS: u32 = 7;
+/// Width of the accumulator's sum `hi + d·a` (`|hi| < |a|`, `|d| ≤ 2`).
+pub const T_BITS: u32 = HI_BITS + 2;
+/// Where a wide sum is split: bits below it are added on one clock, the rest (with the
+/// registered carry) on the next.
+pub const SPLIT: u32 = 57;
 
 const _: () = {
     assert!(LO_BITS >= SHARE_BITS && RATE_BITS <= 1 << COUNT_BITS);
     assert!(SHARE_FRAC <= SHARE_BITS && RATE_FRAC <= RATE_BITS && TURN_BITS == 64);
-    assert!(HI_BITS + LO_BITS <= 256 && X_BITS < 127);
+    assert!(HI_BITS + LO_BITS <= 256 && X_BITS < 127 && T_BITS < 127);
+    assert!(SPLIT < X_BITS && T_BITS - SPLIT <= SPLIT + 1 && SHARE_BITS % 2 == 0);
     assert!(MAX_AXES == 1 << AXIS_BITS);
 };
 
@@ -60,13 +71,15 @@ pub enum State {
     /// Waiting for `start`.
     #[default]
     Idle = 0,
-    /// A product, one bit of `b` per clock.
+    /// A product, one digit of `b` per two clocks (`phase` 0: the low half of the sum; 1: the
+    /// high half, and the shift).
     Multiply = 1,
-    /// The product is used (a write, the angle, the radius) and the next one begins.
+    /// The product is used (`phase` 0: the low half of `base + product`; 1: the high half, a
+    /// write, the angle or the radius, and the next product begins).
     Finish = 2,
     /// The CORDIC's start: the quadrant taken off the angle.
     CordicInit = 3,
-    /// A CORDIC step.
+    /// A CORDIC step (`phase` 0: the shifts; 1: the additions).
     Cordic = 4,
     /// The quadrant put back: the cosine and the sine.
     Rotate = 5,
@@ -127,8 +140,28 @@ pub struct Engine {
     pub half: bool,
     /// The axis of a [`Job::Axis`] product.
     pub k: u8,
-    /// Multiplier: bits of `b` left minus one.
+    /// The half of a two-clock step (see [`State`]).
+    pub phase: bool,
+    /// Multiplier: digits of `b` left minus one.
     pub count: u8,
+    /// Multiplier: the bit of `b` below the next digit (Booth's overlap).
+    pub prev: bool,
+    /// The low [`SPLIT`] bits of a sum added on the last clock.
+    pub low: u128,
+    /// The carry out of them.
+    pub carry: bool,
+    /// CORDIC: `y >> step`, `x >> step` (and the fabric's `atan(step)`, the same on both
+    /// clocks of a step), from the last clock.
+    pub shifted: (i128, i128),
+    /// What the product will be added to (the radius, a plane axis's centre, an axis's start),
+    /// taken on every clock of a product (a memory read and a choice that take a clock of their
+    /// own).
+    pub base: i128,
+    /// The axis of the product after this one (bit 3: there is one), and its share, taken on
+    /// every clock of a product likewise (the choice of the axis and the memory read).
+    pub next: u8,
+    /// See [`Engine::next`].
+    pub next_share: i128,
     /// Multiplier: the signed operand.
     pub a: i128,
     /// Multiplier: the bits of `b` not yet used (lowest next).
@@ -274,10 +307,10 @@ pub fn load_inputs(segment: &Segment, axes: u8) -> Result<Vec<InterpInputs>, Loa
 /// Clocks from the one that takes `start` to the one that raises `done`, both included, for a
 /// segment of this kind.
 pub fn clocks(arc: bool, axes: u8) -> u64 {
-    let product = u64::from(SHARE_BITS) + 1;
+    let product = u64::from(SHARE_BITS) + 2;
     if arc {
         let others = u64::from(axes.saturating_sub(2));
-        1 + (u64::from(RATE_BITS) + 1) + 1 + ITERATIONS as u64 + 1 + product * (3 + others)
+        1 + (u64::from(RATE_BITS) + 2) + 1 + 2 * ITERATIONS as u64 + 1 + product * (3 + others)
     } else {
         1 + product * u64::from(axes)
     }
@@ -340,26 +373,58 @@ impl Engine {
                     if old.seg.arc {
                         self.multiply(r, old.seg.rate as u128, RATE_BITS, Job::Angle);
                     } else {
-                        self.next_axis(old, 0, r);
+                        // A line moves every axis: the first is axis 0.
+                        self.k = 0;
+                        self.multiply(r, share_bits(old.seg.share[0]), SHARE_BITS, Job::Axis);
                     }
                 }
             }
             State::Multiply => {
-                let add = if old.b & 1 == 0 {
+                let first = if old.job == Job::Axis { old.k + 1 } else { 0 };
+                let plane = old.seg.plane;
+                self.next = (first..self.axes)
+                    .find(|&k| !(old.seg.arc && (k == plane[0] || k == plane[1])))
+                    .map_or(0, |k| 8 | k);
+                self.next_share = old.seg.share[usize::from(old.next & 7)];
+                self.base = match old.job {
+                    Job::Radius => old.seg.radius,
+                    Job::Plane => old.seg.centre[usize::from(old.half)],
+                    Job::Angle | Job::Axis => old.seg.from[usize::from(old.k)],
+                };
+                // Booth's digit d = −2·b₁ + b₀ + prev: its magnitude's multiple of a, and
+                // whether it subtracts (then ~multiple + 1).
+                let (b0, b1) = (old.b & 1 == 1, old.b & 2 == 2);
+                let neg = b1 && !(b0 && old.prev);
+                let two = (b1 && !b0 && !old.prev) || (!b1 && b0 && old.prev);
+                let zero = b0 == b1 && b1 == old.prev;
+                let multiple = if zero {
                     0
-                } else if old.count == 0 {
-                    -old.a
+                } else if two {
+                    old.a << 1
                 } else {
                     old.a
                 };
-                let t = wrap(old.hi + add, HI_BITS + 1);
-                self.hi = t >> 1;
-                self.lo = (old.lo >> 1) | (((t & 1) as u128) << (LO_BITS - 1));
-                self.b = old.b >> 1;
-                if old.count == 0 {
-                    self.state = State::Finish;
+                let addend = wrap(if neg { !multiple } else { multiple }, T_BITS);
+                let hi = wrap(old.hi, T_BITS);
+                let mask = (1i128 << SPLIT) - 1;
+                if !old.phase {
+                    let sum = (hi & mask) + (addend & mask) + i128::from(neg);
+                    self.low = (sum & mask) as u128;
+                    self.carry = sum >> SPLIT == 1;
+                    self.phase = true;
                 } else {
-                    self.count = old.count - 1;
+                    let high = (hi >> SPLIT) + (addend >> SPLIT) + i128::from(old.carry);
+                    let t = wrap((high << SPLIT) | old.low as i128, T_BITS);
+                    self.hi = wrap(t >> 2, HI_BITS);
+                    self.lo = (old.lo >> 2) | (((t & 3) as u128) << (LO_BITS - 2));
+                    self.b = old.b >> 2;
+                    self.prev = b1;
+                    self.phase = false;
+                    if old.count == 0 {
+                        self.state = State::Finish;
+                    } else {
+                        self.count = old.count - 1;
+                    }
                 }
             }
             State::Finish => self.finish(old),
@@ -374,19 +439,25 @@ impl Engine {
             }
             State::Cordic => {
                 let n = usize::from(old.step);
-                let (dx, dy) = (old.y >> n, old.x >> n);
-                let atan = constants().atan[n];
-                let (x, y, z) = if old.z >= 0 {
-                    (old.x - dx, old.y + dy, old.z - atan)
+                if !old.phase {
+                    self.shifted = (old.y >> n, old.x >> n);
+                    self.phase = true;
                 } else {
-                    (old.x + dx, old.y - dy, old.z + atan)
-                };
-                self.x = wrap(x, CORDIC_BITS);
-                self.y = wrap(y, CORDIC_BITS);
-                self.z = wrap(z, CORDIC_BITS);
-                self.step = old.step.wrapping_add(1) & 0x3f;
-                if n == ITERATIONS - 1 {
-                    self.state = State::Rotate;
+                    let (dx, dy) = old.shifted;
+                    let atan = constants().atan[n];
+                    let (x, y, z) = if old.z >= 0 {
+                        (old.x - dx, old.y + dy, old.z - atan)
+                    } else {
+                        (old.x + dx, old.y - dy, old.z + atan)
+                    };
+                    self.x = wrap(x, CORDIC_BITS);
+                    self.y = wrap(y, CORDIC_BITS);
+                    self.z = wrap(z, CORDIC_BITS);
+                    self.step = old.step.wrapping_add(1) & 0x3f;
+                    self.phase = false;
+                    if n == ITERATIONS - 1 {
+                        self.state = State::Rotate;
+                    }
                 }
             }
             State::Rotate => {
@@ -405,10 +476,25 @@ impl Engine {
 
     /// A product's use, and the next step.
     fn finish(&mut self, old: &Engine) {
-        // The product shifted right by 62 (a share's product) or 120 (the rate's), low bits.
+        // The product shifted right by 62 (a share's product), low bits, and what it is added
+        // to (taken while the product was formed).
         let p62 = wrap(
             (old.hi << (SHARE_BITS - SHARE_FRAC))
                 | (old.lo >> (LO_BITS - SHARE_BITS + SHARE_FRAC)) as i128,
+            X_BITS,
+        );
+        let base = old.base;
+        let mask = (1i128 << SPLIT) - 1;
+        if !old.phase {
+            let sum = (base & mask) + (p62 & mask);
+            self.low = (sum & mask) as u128;
+            self.carry = sum >> SPLIT == 1;
+            self.phase = true;
+            return;
+        }
+        self.phase = false;
+        let sum = wrap(
+            (((base >> SPLIT) + (p62 >> SPLIT) + i128::from(old.carry)) << SPLIT) | old.low as i128,
             X_BITS,
         );
         match old.job {
@@ -423,16 +509,14 @@ impl Engine {
                 self.state = State::CordicInit;
             }
             Job::Radius => {
-                let rho = wrap(old.seg.radius + p62, X_BITS);
-                self.rho = rho;
+                self.rho = sum;
                 self.half = false;
-                self.multiply(rho, share_bits(old.cos), SHARE_BITS, Job::Plane);
+                self.multiply(sum, share_bits(old.cos), SHARE_BITS, Job::Plane);
             }
             Job::Plane => {
-                let h = usize::from(old.half);
-                self.write(old.seg.plane[h], wrap(old.seg.centre[h] + p62, X_BITS));
+                self.write(old.seg.plane[usize::from(old.half)], sum);
                 if old.half {
-                    self.next_axis(old, 0, old.r);
+                    self.next_product(old);
                 } else {
                     self.half = true;
                     self.multiply(old.rho, share_bits(old.sin), SHARE_BITS, Job::Plane);
@@ -440,8 +524,8 @@ impl Engine {
             }
             Job::Axis => {
                 let k = old.k;
-                self.write(k, wrap(old.seg.from[usize::from(k)] + p62, X_BITS));
-                self.next_axis(old, k + 1, old.r);
+                self.write(k, sum);
+                self.next_product(old);
             }
         }
     }
@@ -453,34 +537,28 @@ impl Engine {
         self.out.out_value = value;
     }
 
-    /// The product `r · share_k` for the first axis `k ≥ from` the segment moves as on a line
-    /// (all on a line; the plane's two excepted on an arc), or the end of the computation.
-    fn next_axis(&mut self, old: &Engine, from: u8, r: i128) {
-        let plane = old.seg.plane;
-        match (from..self.axes).find(|&k| !(old.seg.arc && (k == plane[0] || k == plane[1]))) {
-            Some(k) => {
-                self.k = k;
-                self.multiply(
-                    r,
-                    share_bits(old.seg.share[usize::from(k)]),
-                    SHARE_BITS,
-                    Job::Axis,
-                );
-            }
-            None => {
-                self.state = State::Idle;
-                self.out.done = true;
-            }
+    /// The product `r · share_k` for the next axis that moves as on a line (all on a line; the
+    /// plane's two excepted on an arc), chosen while the last product was formed, or the end
+    /// of the computation.
+    fn next_product(&mut self, old: &Engine) {
+        if old.next & 8 != 0 {
+            self.k = old.next & 7;
+            self.multiply(old.r, share_bits(old.next_share), SHARE_BITS, Job::Axis);
+        } else {
+            self.state = State::Idle;
+            self.out.done = true;
         }
     }
 
-    /// Begins the product `a · b`, `b` of `n` bits.
+    /// Begins the product `a · b`, `b` of `n` bits (`n / 2` digits).
     fn multiply(&mut self, a: i128, b: u128, n: u32, job: Job) {
         self.a = a;
         self.b = b;
+        self.prev = false;
+        self.phase = false;
         self.hi = 0;
         self.lo = 0;
-        self.count = (n - 1) as u8;
+        self.count = (n / 2 - 1) as u8;
         self.job = job;
         self.state = State::Multiply;
     }
@@ -588,10 +666,10 @@ mod tests {
     }
 
     #[test]
-    fn a_line_of_one_axis_takes_66_clocks_and_an_arc_of_four_519() {
-        assert_eq!(clocks(false, 1), 66);
-        assert_eq!(clocks(true, 4), 519);
-        assert_eq!(clocks(true, 8), 779);
+    fn a_line_of_one_axis_takes_67_clocks_and_an_arc_of_four_587() {
+        assert_eq!(clocks(false, 1), 67);
+        assert_eq!(clocks(true, 4), 587);
+        assert_eq!(clocks(true, 8), 851);
     }
 
     #[test]
