@@ -23,57 +23,13 @@ use snapgen_model::path::interp::{Path, Segment};
 use snapgen_model::{InterpInputs, InterpOutputs, FRAC_BITS};
 use snapgen_plan::path::{prepare, Element};
 
-use crate::layout::{harness_header, pack, Port, PortValue, Slot};
+use crate::layout::{harness_header, port_layout};
 use crate::verilated::{abi, VcdWindow, Verilated};
 use crate::SimError;
 
-/// The interpolator's port tables, encoders and decoder, from the spec's port list.
-macro_rules! interp_layout {
-    (
-        clock: $cdoc:literal;
-        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
-        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
-    ) => {
-        /// The interpolator's inputs, in the harness's word order.
-        pub const INTERP_INPUTS: [Port; [$($(stringify!($i)),*),*].len()] =
-            [$($( Port { name: stringify!($i), bits: $ib }, )*)*];
-
-        /// The interpolator's outputs, in the harness's word order.
-        pub const INTERP_OUTPUTS: [Port; [$($(stringify!($o)),*),*].len()] =
-            [$($( Port { name: stringify!($o), bits: $ob }, )*)*];
-
-        /// A clock's inputs in the harness's layout.
-        pub fn encode_inputs(i: &InterpInputs) -> [u32; IN_WORDS] {
-            let mut w = [0u32; IN_WORDS];
-            let mut k = 0;
-            $($( IN_SLOTS[k].put(&mut w, PortValue::to_word(i.$i)); k += 1; )*)*
-            debug_assert_eq!(k, IN_SLOTS.len());
-            w
-        }
-
-        /// A clock's outputs in the harness's layout.
-        pub fn encode_outputs(o: &InterpOutputs) -> [u32; OUT_WORDS] {
-            let mut w = [0u32; OUT_WORDS];
-            let mut k = 0;
-            $($( OUT_SLOTS[k].put(&mut w, PortValue::to_word(o.$o)); k += 1; )*)*
-            debug_assert_eq!(k, OUT_SLOTS.len());
-            w
-        }
-    };
-}
-
-snapgen_spec::with_interpolator_ports!(interp_layout! {});
-
-const IN_LAYOUT: ([Slot; INTERP_INPUTS.len()], usize) = pack(&INTERP_INPUTS);
-const OUT_LAYOUT: ([Slot; INTERP_OUTPUTS.len()], usize) = pack(&INTERP_OUTPUTS);
-/// Where each input is in a clock's input words.
-pub const IN_SLOTS: [Slot; INTERP_INPUTS.len()] = IN_LAYOUT.0;
-/// Where each output is in a clock's output words.
-pub const OUT_SLOTS: [Slot; INTERP_OUTPUTS.len()] = OUT_LAYOUT.0;
-/// Input words per clock.
-pub const IN_WORDS: usize = IN_LAYOUT.1;
-/// Output words per clock.
-pub const OUT_WORDS: usize = OUT_LAYOUT.1;
+snapgen_spec::with_interpolator_ports!(port_layout! {
+    INTERP_INPUTS, INTERP_OUTPUTS, InterpInputs, InterpOutputs;
+});
 
 /// The interpolator's tag in the harness's ABI word.
 const INTERP_TAG: u32 = 3;

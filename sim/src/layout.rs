@@ -190,6 +190,61 @@ pub const fn pack<const N: usize>(ports: &[Port; N]) -> ([Slot; N], usize) {
     (slots, if N == 0 { 0 } else { place(ports, N - 1).1 })
 }
 
+/// A block's port tables, word layouts and encoders from one of the spec's port lists (called
+/// through its `with_*_ports!` macro): the tables `$ins` and `$outs` (the harness's word
+/// order), `IN_SLOTS`, `OUT_SLOTS`, `IN_WORDS`, `OUT_WORDS`, and `encode_inputs` and
+/// `encode_outputs` for the model's port structs `$ity` and `$oty` (one `put` per port with a
+/// constant slot: straight-line code).
+macro_rules! port_layout {
+    (
+        $ins:ident, $outs:ident, $ity:ty, $oty:ty;
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
+    ) => {
+        /// The block's inputs, in the harness's word order.
+        pub const $ins: [$crate::layout::Port; [$($(stringify!($i)),*),*].len()] =
+            [$($( $crate::layout::Port { name: stringify!($i), bits: $ib }, )*)*];
+
+        /// The block's outputs, in the harness's word order.
+        pub const $outs: [$crate::layout::Port; [$($(stringify!($o)),*),*].len()] =
+            [$($( $crate::layout::Port { name: stringify!($o), bits: $ob }, )*)*];
+
+        const IN_LAYOUT: ([$crate::layout::Slot; $ins.len()], usize) = $crate::layout::pack(&$ins);
+        const OUT_LAYOUT: ([$crate::layout::Slot; $outs.len()], usize) = $crate::layout::pack(&$outs);
+        /// Where each input is in a clock's input words.
+        pub const IN_SLOTS: [$crate::layout::Slot; $ins.len()] = IN_LAYOUT.0;
+        /// Where each output is in a clock's output words.
+        pub const OUT_SLOTS: [$crate::layout::Slot; $outs.len()] = OUT_LAYOUT.0;
+        /// Input words per clock.
+        pub const IN_WORDS: usize = IN_LAYOUT.1;
+        /// Output words per clock.
+        pub const OUT_WORDS: usize = OUT_LAYOUT.1;
+
+        /// A clock's inputs in the harness's word layout.
+        #[inline(always)]
+        pub fn encode_inputs(i: &$ity) -> [u32; IN_WORDS] {
+            let mut w = [0u32; IN_WORDS];
+            let mut k = 0;
+            $($( IN_SLOTS[k].put(&mut w, $crate::layout::PortValue::to_word(i.$i)); k += 1; )*)*
+            debug_assert_eq!(k, IN_SLOTS.len());
+            w
+        }
+
+        /// A clock's outputs in the harness's word layout: what the co-simulation compares the
+        /// fabric's words with, on every clock.
+        #[inline(always)]
+        pub fn encode_outputs(o: &$oty) -> [u32; OUT_WORDS] {
+            let mut w = [0u32; OUT_WORDS];
+            let mut k = 0;
+            $($( OUT_SLOTS[k].put(&mut w, $crate::layout::PortValue::to_word(o.$o)); k += 1; )*)*
+            debug_assert_eq!(k, OUT_SLOTS.len());
+            w
+        }
+    };
+}
+pub(crate) use port_layout;
+
 /// The C++ type Verilator gives a port of `bits` bits is a wide array (more than 64 bits).
 fn wide(bits: u32) -> bool {
     bits > 64

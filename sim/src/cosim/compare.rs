@@ -114,7 +114,7 @@ impl std::fmt::Display for Mismatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fabric::{decode, encode, OUT_WORDS};
+    use crate::fabric::{decode, encode_outputs, OUT_WORDS};
 
     /// Outputs with every port's bits drawn from `seed` (random words, decoded).
     fn outputs(seed: u64) -> CoreOutputs {
@@ -130,7 +130,7 @@ mod tests {
     fn the_comparison_sees_every_bit_of_every_word() {
         for seed in 0..64 {
             let m = outputs(seed);
-            let words = encode(&m);
+            let words = encode_outputs(&m);
             assert_eq!(decode(&words), m, "layout round trip, seed {seed}");
             for k in 0..OUT_WORDS {
                 for bit in 0..32 {

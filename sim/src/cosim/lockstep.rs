@@ -11,7 +11,7 @@
 use snapgen_model::{CoreInputs, CoreModel, CoreOutputs, Format};
 
 use super::{Fault, Mismatch, Register};
-use crate::fabric::{encode, Fabric, OUT_WORDS};
+use crate::fabric::{encode_outputs, Fabric, OUT_WORDS};
 
 /// Clocks per batch: the model's and the fabric's words of a batch (76 bytes a clock each)
 /// stay in the L1/L2 cache between being written and compared.
@@ -169,7 +169,7 @@ impl Lockstep {
         loop {
             let (m, t) = self.side.clock(inputs);
             if record {
-                self.want.extend_from_slice(&encode(&m));
+                self.want.extend_from_slice(&encode_outputs(&m));
             } else {
                 std::hint::black_box(m);
             }
