@@ -266,6 +266,8 @@ pub struct BoardSynth {
     /// The path interpolator for [`INTERPOLATOR_AXES`] axes, on its own (issue 22: not yet
     /// part of the board's design).
     pub interpolator: crate::yosys::SynthReport,
+    /// The step/dir generator of one axis, on its own (issue 22: not yet in the design).
+    pub step_dir: crate::yosys::SynthReport,
 }
 
 /// Axes of the path interpolator `snapgen synth` reports (issue 22's target: at least 4).
@@ -340,7 +342,7 @@ impl BoardSynth {
         format!(
             "Yosys synth_xilinx -family {} for the {} ({}: {}, package {}, speed grade {}):\n\n\
              | design | LUT | FF | CARRY4 | DSP48E1 | LUT-RAM cells | BRAM36 | logic-only path (ns) |\n\
-             |---|---|---|---|---|---|---|---|\n{}{}{}{}\n\
+             |---|---|---|---|---|---|---|---|\n{}{}{}{}{}\n\
              Logic-only path: Yosys `sta` with the Xilinx cell library's specify blocks; routing is\n\
              not included. Motion core budget: ≤ {CORE_LUT_BUDGET} LUT, ≤ {CORE_FF_BUDGET} FF,\n\
              ≤ {CORE_PATH_BUDGET_NS} ns (its program memory is the LUT-RAM, reported apart; its\n\
@@ -373,6 +375,11 @@ impl BoardSynth {
                 &self.interpolator.resources,
                 self.interpolator.path_ns
             ),
+            row(
+                "step/dir generator of one axis, on its own (issue 22; not yet in the design)",
+                &self.step_dir.resources,
+                self.step_dir.path_ns
+            ),
         )
     }
 }
@@ -402,11 +409,17 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
     )
     .with_context(|| format!("cannot write {}", file.display()))?;
     let interpolator = crate::yosys::synth(&[file], prefix, &b.family)?;
+    let prefix = snapgen_hdl::step_dir::STEP_DIR_PREFIX;
+    let file = dir.join(format!("{prefix}.v"));
+    std::fs::write(&file, snapgen_hdl::step_dir::step_dir_verilog())
+        .with_context(|| format!("cannot write {}", file.display()))?;
+    let step_dir = crate::yosys::synth(&[file], prefix, &b.family)?;
     let _ = std::fs::remove_dir_all(&dir);
     Ok(BoardSynth {
         board: b.clone(),
         full,
         core,
         interpolator,
+        step_dir,
     })
 }

@@ -24,7 +24,6 @@ use snapgen_model::InterpInputs;
 use snapgen_spec::widths::{MAX_AXES, RATE_BITS, RATE_FRAC, SHARE_BITS, SHARE_FRAC};
 
 use crate::block_with_ports;
-use crate::protocol_v::LocalParam;
 use crate::sim_bits::{from_i128, to_i128, to_u128};
 use crate::template::{fill, Holes};
 
@@ -120,8 +119,7 @@ fn interpolator_body(axes: u8) -> String {
         .block("atan_cases", atan_cases());
     let body =
         fill("interpolator.v", TEMPLATE, &holes).expect("the interpolator's template is filled");
-    let mut params = crate::protocol_v::localparams();
-    for (name, bits) in [
+    let params = crate::protocol_v::localparams_with(&[
         ("SHARE_BITS", SHARE_BITS),
         ("SHARE_FRAC", SHARE_FRAC),
         ("RATE_BITS", RATE_BITS),
@@ -131,9 +129,7 @@ fn interpolator_body(axes: u8) -> String {
         ("CORDIC_BITS", CORDIC_BITS),
         ("T_BITS", T_BITS),
         ("SPLIT", SPLIT),
-    ] {
-        params.push(LocalParam::new(name, 32, u64::from(bits)));
-    }
+    ]);
     crate::protocol_v::with_localparams(&params, &body)
 }
 

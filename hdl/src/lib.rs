@@ -44,6 +44,7 @@ pub mod servo;
 pub mod sign_extend;
 pub mod sim_bits;
 pub mod status_block;
+pub mod step_dir;
 pub mod stop_unit;
 pub mod swap_timer;
 pub mod template;

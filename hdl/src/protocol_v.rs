@@ -57,6 +57,15 @@ pub fn localparams() -> Vec<LocalParam> {
     v
 }
 
+/// [`localparams`] and a block's own widths (name, value; 32-bit localparams).
+pub fn localparams_with(own: &[(&str, u32)]) -> Vec<LocalParam> {
+    let mut v = localparams();
+    for &(name, bits) in own {
+        v.push(LocalParam::new(name, 32, u64::from(bits)));
+    }
+    v
+}
+
 /// A little-endian field of `bytes` bytes at payload byte `at`, for a payload of `n` bytes
 /// received into `vector` newest byte first (byte `k` is `vector[8(n-1-k) +: 8]`), as a
 /// Verilog concatenation (most significant byte first).

@@ -83,6 +83,11 @@ fn every_block_lints_clean() {
         snapgen_hdl::io_top::IoTop::default(),
         &snapgen_hdl::verilog::io_top_waivers(),
     );
+    lint(
+        "step_dir",
+        snapgen_hdl::step_dir::StepDirGenerator::default(),
+        &[],
+    );
     // The interpolator at the smallest, an odd and the largest number of axes.
     for axes in [1, 3, 8] {
         lint(

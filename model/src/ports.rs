@@ -9,6 +9,8 @@
 //!   block as a [`snapgen_spec::Status`].
 //! * [`InterpInputs`], [`InterpOutputs`]: the path interpolator (`snapgen_interpolator`,
 //!   [`crate::path::engine`]) for one clock.
+//! * [`StepDirInputs`], [`StepDirOutputs`]: the step/dir generator (`snapgen_step_dir`,
+//!   [`crate::io::step_dir`]) for one clock.
 
 /// A block's inputs and outputs as two structs.
 macro_rules! port_structs {
@@ -38,6 +40,9 @@ snapgen_spec::with_motion_core_ports!(
 snapgen_spec::with_io_top_ports!(port_structs! { IoInputs, IoOutputs, "the I/O top"; });
 snapgen_spec::with_interpolator_ports!(port_structs! {
     InterpInputs, InterpOutputs, "the path interpolator";
+});
+snapgen_spec::with_step_dir_ports!(port_structs! {
+    StepDirInputs, StepDirOutputs, "the step/dir generator";
 });
 
 /// The core's `command` inputs and `status` outputs as structs of their own.

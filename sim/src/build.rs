@@ -147,12 +147,34 @@ pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
 /// Builds (or finds in the cache) the library of the path interpolator for `axes` axes
 /// ([`crate::interp`]), with VCD tracing if `trace`.
 pub fn build_interpolator(axes: u8, trace: bool) -> Result<Built, SimError> {
+    build_interpolator_from(
+        &snapgen_hdl::interpolator::interpolator_verilog(axes),
+        trace,
+    )
+}
+
+/// Builds the interpolator's library from the Verilog `verilog` (the generator's, or a
+/// deliberately altered copy: the tests show that the co-simulation finds an altered line).
+pub fn build_interpolator_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
     build_with(
         "interp",
         snapgen_hdl::interpolator::INTERPOLATOR_PREFIX,
-        &snapgen_hdl::interpolator::interpolator_verilog(axes),
+        verilog,
         HARNESS_CPP,
         &crate::interp::interp_layout_header(),
+        trace,
+    )
+}
+
+/// Builds (or finds in the cache) the library of the step/dir generator ([`crate::step_dir`]),
+/// with VCD tracing if `trace`.
+pub fn build_step_dir(trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "step-dir",
+        snapgen_hdl::step_dir::STEP_DIR_PREFIX,
+        &snapgen_hdl::step_dir::step_dir_verilog(),
+        HARNESS_CPP,
+        &crate::step_dir::step_dir_layout_header(),
         trace,
     )
 }

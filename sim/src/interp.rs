@@ -6,9 +6,10 @@
 //! (`snapgen_plan::path`: lines, arcs and helices in random planes, joined end to end), each
 //! loaded as the host would load it and computed at 1 to 4 random distances along it (a cell
 //! before its start to a cell past its end); now and then a segment of random bits instead
-//! (every register's wrapping is part of the contract), a start or a load while a computation
-//! runs, or a reset. Each computation of a planner's segment that nothing disturbed is also
-//! checked against the rule itself, [`Segment::at`]: the model's writes must equal it.
+//! (every register's wrapping is part of the contract), a start, an axis load or a shape load
+//! while a computation runs, or a reset (while computing or idle). Each computation of a
+//! planner's segment that nothing disturbed is also checked against the rule itself,
+//! [`Segment::at`]: the model's writes must equal it.
 //!
 //! As in the core's lockstep, the model runs a batch of clocks first (its inputs and its
 //! outputs in the harness's word layout), the fabric the same clocks in one call, and the two
@@ -121,6 +122,11 @@ pub struct InterpReport {
     pub checked: u64,
     /// Of those, how many the model got wrong (must be 0).
     pub rule_errors: u64,
+    /// Segments of random bits loaded.
+    pub random_segments: u64,
+    /// Disturbances while computing: starts, axis loads, shape loads (random bits), resets;
+    /// and resets while idle.
+    pub disturbances: [u64; 5],
     /// The first difference between fabric and model, if any.
     pub mismatch: Option<InterpMismatch>,
 }
@@ -239,23 +245,42 @@ impl Stimulus {
                     share: self.rng.gen(),
                     ..Default::default()
                 }),
-                30..=34 => Some(InterpInputs {
+                30..=34 => random_load(&mut self.rng, self.axes).first().copied(),
+                35..=44 => Some(InterpInputs {
                     reset: true,
                     ..Default::default()
                 }),
                 _ => None,
             };
             if let Some(d) = disturb {
+                let kind = if d.start {
+                    0
+                } else if d.load_axis {
+                    1
+                } else if d.load_shape {
+                    2
+                } else {
+                    3
+                };
+                report.disturbances[kind] += 1;
                 if !d.start {
                     self.expect = None;
                 }
-                if d.load_axis {
+                if d.load_axis || d.load_shape {
                     // The segment is no longer the planner's: load a fresh one next.
                     self.current = None;
                 }
                 return d;
             }
             return InterpInputs::default();
+        }
+        if self.rng.gen_bool(0.001) {
+            // A reset while idle changes nothing but the outputs it clears.
+            report.disturbances[4] += 1;
+            return InterpInputs {
+                reset: true,
+                ..Default::default()
+            };
         }
         // Idle: the next computation, on the current segment or a new one.
         let cell = 1i128 << FRAC_BITS;
@@ -275,6 +300,7 @@ impl Stimulus {
                 report.segments += 1;
                 if self.rng.gen_bool(0.1) {
                     // Random bits, computed once at a random offset (no rule check).
+                    report.random_segments += 1;
                     self.queue.extend(random_load(&mut self.rng, self.axes));
                     self.queue.push_back(InterpInputs {
                         start: true,

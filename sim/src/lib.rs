@@ -11,7 +11,8 @@
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
 //! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
 //!   model under random command streams; [`board`] is the virtual board on it.
-//! * [`interp`] runs the path interpolator in lockstep with its model (issue 22).
+//! * [`interp`] runs the path interpolator in lockstep with its model, [`step_dir`] the
+//!   step/dir generator (issue 22).
 
 pub mod board;
 pub mod build;
@@ -24,6 +25,7 @@ pub mod io;
 pub mod io_cosim;
 pub mod layout;
 pub mod moves;
+pub mod step_dir;
 pub mod vcd;
 pub mod verilated;
 pub mod wrapper;

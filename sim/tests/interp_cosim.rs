@@ -2,9 +2,10 @@
 //! random stream of `snapgen_sim::interp` (needs Verilator; the README's test command installs
 //! it): at one, three and eight axes, with no difference and every undisturbed computation of
 //! a planner's segment equal to the rule; and a one-bit fault in any output is found at its
-//! clock.
+//! clock (that shows the comparison and its report work; that the stream reaches the logic is
+//! shown by the disturbance counts and by the rule checks).
 
-use snapgen_sim::build::build_interpolator;
+use snapgen_sim::build::{build_interpolator, build_interpolator_from};
 use snapgen_sim::interp::{run, InterpConfig, InterpFault, INTERP_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> InterpConfig {
@@ -29,6 +30,11 @@ fn fabric_and_model_agree_on_every_clock() {
             r.computations > r.checked && r.segments > 100,
             "{axes} axes: {r:?}"
         );
+        // Every kind of disturbance happened, and segments of random bits.
+        assert!(
+            r.disturbances.iter().all(|&n| n > 0) && r.random_segments > 0,
+            "{axes} axes: {r:?}"
+        );
         eprintln!("{axes} axes: {r:?}");
     }
 }
@@ -47,5 +53,36 @@ fn a_one_bit_fault_in_any_output_is_found() {
             assert_eq!((m.clock, m.port), (clock, p.name));
             assert_eq!(m.expected ^ m.actual, 1 << (bit % p.bits));
         }
+    }
+}
+
+/// The stream reaches the logic: a fabric with one line of its Verilog altered (a carry
+/// dropped, an arithmetic shift made logical, a prefetched share read from the axis after)
+/// disagrees with the model within the suite's clocks.
+#[test]
+fn an_altered_line_of_the_verilog_is_found() {
+    let good = snapgen_hdl::interpolator::interpolator_verilog(3);
+    for (from, to) in [
+        (
+            "+ {{(T_BITS-SPLIT-1){1'b0}}, carry};",
+            "+ {(T_BITS-SPLIT){1'b0}};",
+        ),
+        (
+            "cy_shift <= $signed(cy) >>> step;",
+            "cy_shift <= cy >> step;",
+        ),
+        (
+            "next_share <= seg_share[next_q[2:0]];",
+            "next_share <= seg_share[next_q[2:0] + 3'd1];",
+        ),
+    ] {
+        assert_eq!(
+            good.matches(from).count(),
+            if from.starts_with("next") { 2 } else { 1 }
+        );
+        let bad = good.replace(from, to);
+        let lib = build_interpolator_from(&bad, false).expect("the altered design builds");
+        let r = run(&lib.library, &config(3, 2_000_000, 3)).expect("runs");
+        assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }
 }

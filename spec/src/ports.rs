@@ -247,6 +247,43 @@ macro_rules! with_interpolator_ports {
     };
 }
 
+/// Calls `$callback! { $($extra)* <the step/dir generator's ports> }` (see the module
+/// documentation): one axis's stepper-drive output, made from its whole-LSB position
+/// (`snapgen_model::io::step_dir`, issue 22).
+#[macro_export]
+macro_rules! with_step_dir_ports {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            clock: "Fabric clock.";
+            inputs {
+                reset {
+                    reset: bit[1] bool, "Synchronous reset, active high: disabled, no pulse, the overrun flag cleared.";
+                }
+                config {
+                    step_lsb: bits[$crate::widths::STEP_TIMER_BITS] u16, "Output LSBs per step (0 acts as 1).";
+                    high_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks the step line stays high (0 acts as 1).";
+                    low_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks the step line stays low after a pulse (0 acts as 1).";
+                    setup_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks the direction line is stable before a step's rising edge after it changes (0 acts as 1).";
+                }
+                axis {
+                    enable: bit[1] bool, "Pulses follow the position; while low the step grid is anchored at the position (no pulse).";
+                    position: bits[$crate::widths::POSITION_BITS] u32, "The axis's position in whole output LSBs (the core's `position`; wraps).";
+                }
+            }
+            outputs {
+                pins {
+                    step: bit[1] bool, "Step line: one pulse per step, rising edge = the step.";
+                    dir: bit[1] bool, "Direction line: high for steps toward a larger position.";
+                }
+                status {
+                    steps: bits[$crate::widths::POSITION_BITS] u32, "Steps issued since enabled, signed (wraps).";
+                    overrun: bit[1] bool, "The position ran more than one step ahead of the pulses (sticky until disabled or reset): the axis moves faster than the pulse rate allows.";
+                }
+            }
+        }
+    };
+}
+
 /// Builds a [`Block`] table from a port list.
 macro_rules! block_table {
     (
@@ -379,7 +416,7 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_sections_known() {
-        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR] {
+        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR, STEP_DIR] {
             let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
             names.push(b.clock);
             let n = names.len();

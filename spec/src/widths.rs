@@ -57,6 +57,9 @@ pub const RATE_FRAC: u32 = 120;
 /// Width of an angle: a full turn is `2^TURN_BITS`.
 pub const TURN_BITS: u32 = 64;
 
+/// Width of the step/dir generator's step length and its pulse timers (clocks).
+pub const STEP_TIMER_BITS: u32 = 16;
+
 /// Bytes that hold `bits` bits.
 pub const fn bytes_for(bits: u32) -> usize {
     bits.div_ceil(8) as usize

@@ -1,7 +1,7 @@
 //! `snapgen verilog`: the motion core (`snapgen_core.v`) and the I/O top (`snapgen_io.v`,
 //! which instantiates it) for a clock, baud rate and Ts; with `--interpolator AXES` also the
-//! path interpolator (`snapgen_interpolator.v`, issue 22: a block of its own, not yet in the
-//! design).
+//! path interpolator (`snapgen_interpolator.v`), with `--step-dir` the step/dir generator
+//! (`snapgen_step_dir.v`): issue 22's blocks of their own, not yet in the design.
 
 use std::path::{Path, PathBuf};
 
@@ -22,6 +22,10 @@ pub struct Args {
     /// `snapgen_interpolator.v` (a block of its own: no design instantiates it yet).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
     interpolator: Option<u8>,
+    /// Also write the step/dir generator of one axis as `snapgen_step_dir.v` (a block of its
+    /// own: no design instantiates it yet).
+    #[arg(long)]
+    step_dir: bool,
 }
 
 /// Runs the subcommand.
@@ -46,6 +50,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         std::fs::write(&file, snapgen_hdl::interpolator::interpolator_verilog(axes))
             .with_context(|| format!("cannot write {}", file.display()))?;
         println!("wrote {} ({axes} axes)", file.display());
+    }
+    if a.step_dir {
+        let file = a
+            .out
+            .join(format!("{}.v", snapgen_hdl::step_dir::STEP_DIR_PREFIX));
+        std::fs::write(&file, snapgen_hdl::step_dir::step_dir_verilog())
+            .with_context(|| format!("cannot write {}", file.display()))?;
+        println!("wrote {}", file.display());
     }
     Ok(())
 }

@@ -12,6 +12,7 @@ pub mod quadrature;
 pub mod reply_queue;
 pub mod reply_tx;
 pub mod servo;
+pub mod step_dir;
 pub mod uart;
 
 /// One input through a two-flop synchroniser and a glitch filter: a new level is accepted

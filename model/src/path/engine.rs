@@ -11,10 +11,10 @@
 //!   as [`super::interp`]'s 256-bit `mul_shift`;
 //! * the **CORDIC** of [`super::cordic`], one step per two clocks.
 //!
-//! No addition wider than [`SPLIT`]` + 1` bits happens in one clock, so the block closes routed
-//! timing (docs/PATH.md): the accumulator's [`T_BITS`]-bit sum is added low half then high half
-//! (the carry between them registered), as is each product's use (`base + product`, two
-//! clocks), and a CORDIC step shifts on one clock and adds on the next.
+//! For routed timing (docs/PATH.md) the wide sums take two clocks: the accumulator's
+//! [`T_BITS`]-bit sum is added low half then high half (the carry between them registered), as
+//! is each product's use (`base + product`); a CORDIC step shifts on one clock and adds (65
+//! bits) on the next; the angle's 64-bit sum is the widest left in one clock.
 //!
 //! A computation starts on `start` (while idle) with `offset`, the distance `r` into the
 //! loaded segment, and writes each axis once (`out_write`, `out_axis`, `out_value`), `done`
@@ -45,8 +45,8 @@ use crate::ports::{InterpInputs, InterpOutputs};
 pub const HI_BITS: u32 = X_BITS + 1;
 /// Width of the multiplier's low accumulator and of its `b` operand register.
 pub const LO_BITS: u32 = RATE_BITS;
-/// Width of the CORDIC's `x`, `y` and `z` (a share and its sign: `|x|, |y| ≤ 2^62` and
-/// `|z| ≤ 2^61` on every step, tested).
+/// Width of the CORDIC's `x`, `y` and `z` (a share and its sign: `|x|, |y| < 2^63` and
+/// `|z| ≤ 2^62` on every step, tested).
 pub const CORDIC_BITS: u32 = SHARE_BITS + 1;
 /// Width of the multiplier's digit counter.
 pub const COUNT_BITS: u32 = 7;
@@ -194,7 +194,9 @@ pub struct Engine {
     out: InterpOutputs,
 }
 
-/// Why a segment cannot be loaded into the interpolator.
+/// Why a segment cannot be loaded into the interpolator (a segment that loads is computed
+/// exactly as [`Segment::at`] at every offset from a cell before its start to a cell past its
+/// end: no register on the way wraps).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum LoadError {
     /// The segment names more axes than the design has.
@@ -240,6 +242,22 @@ fn fits(what: &'static str, value: i128, bits: u32, signed: bool) -> Result<i128
     }
 }
 
+/// The largest magnitude of `base + ((r · slope) >> 62)` over `r` from `−cell` to `r_end` (a
+/// line in `r`: at one of the two ends), saturating.
+fn reach(base: i128, slope: i128, r_end: i128) -> i128 {
+    let at = |r: i128| {
+        let v = ethnum::I256::from(base)
+            + ((ethnum::I256::from(r) * ethnum::I256::from(slope)) >> SHARE_FRAC);
+        let m = v.unsigned_abs();
+        if m > ethnum::U256::from(i128::MAX as u128) {
+            i128::MAX
+        } else {
+            m.as_i128()
+        }
+    };
+    at(-(1i128 << crate::FRAC_BITS)).max(at(r_end))
+}
+
 /// The clocks' inputs that load `segment` into an interpolator of `axes` axes: the shape, then
 /// one axis per clock (every other input at rest). Refuses a value that would not fit its port.
 pub fn load_inputs(segment: &Segment, axes: u8) -> Result<Vec<InterpInputs>, LoadError> {
@@ -252,6 +270,19 @@ pub fn load_inputs(segment: &Segment, axes: u8) -> Result<Vec<InterpInputs>, Loa
             got: from.len(),
             axes,
         });
+    }
+    // The offsets the segment is computed at: a cell before its start to a cell past its end;
+    // every value on the way must fit its register for the fabric to follow the rule.
+    let r_max = segment
+        .length
+        .abs()
+        .saturating_add(1i128 << crate::FRAC_BITS);
+    fits("length", r_max, X_BITS, true)?;
+    for (k, (&x, &d)) in from.iter().zip(share).enumerate() {
+        let plane_axis = matches!(&segment.shape, Shape::Arc { plane, .. } if plane.contains(&k));
+        if !plane_axis {
+            fits("axis's reach", reach(x, d, r_max), X_BITS, true)?;
+        }
     }
     let mut shape = InterpInputs {
         load_shape: true,
@@ -268,7 +299,7 @@ pub fn load_inputs(segment: &Segment, axes: u8) -> Result<Vec<InterpInputs>, Loa
         ..
     } = &segment.shape
     {
-        if plane[0] >= n || plane[1] >= n || plane[0] == plane[1] {
+        if plane[0] >= from.len() || plane[1] >= from.len() || plane[0] == plane[1] {
             return Err(LoadError::Plane {
                 first: plane[0],
                 second: plane[1],
@@ -285,6 +316,17 @@ pub fn load_inputs(segment: &Segment, axes: u8) -> Result<Vec<InterpInputs>, Loa
         shape.growth = fits("radius growth", *growth, SHARE_BITS, true)?;
         shape.start_angle = start.0;
         shape.rate = fits("angular rate", *rate, RATE_BITS - 1, false)?;
+        // The radius, and the plane's axes (within the radius of the centre), over the reach.
+        let rho = reach(*radius, *growth, r_max);
+        fits("radius over the segment", rho, X_BITS, true)?;
+        for c in centre {
+            fits(
+                "arc's reach",
+                c.saturating_abs().saturating_add(rho),
+                X_BITS,
+                true,
+            )?;
+        }
     }
     let mut out = vec![shape];
     for k in 0..n {
@@ -350,8 +392,8 @@ impl Engine {
             s.start_angle = i.start_angle;
             s.rate = wrap(i.rate, RATE_BITS);
         }
-        if i.load_axis && i.axis < self.axes {
-            let k = usize::from(i.axis);
+        if i.load_axis && (i.axis & 7) < self.axes {
+            let k = usize::from(i.axis & 7);
             self.seg.from[k] = wrap(i.from, X_BITS);
             self.seg.share[k] = wrap(i.share, SHARE_BITS);
         }
@@ -610,7 +652,7 @@ mod tests {
         )
     }
 
-    /// A random segment of `axes` axes on a grid of up to 2^30 output LSBs, as the host makes
+    /// A random segment of `axes` axes on a grid of up to 2^29 output LSBs, as the host makes
     /// them (raw = LSB · 2^80), and a random offset within it or a cell beyond.
     fn random_segment(rng: &mut impl Rng, axes: u8) -> (Segment, i128) {
         let raw = |lsb: i128| lsb << crate::FRAC_BITS;
@@ -744,13 +786,37 @@ mod tests {
                 dir: vec![ONE],
             },
         };
-        assert!(matches!(
-            load_inputs(&g, 1),
-            Err(LoadError::Width { what: "start", .. })
-        ));
+        assert!(matches!(load_inputs(&g, 1), Err(LoadError::Width { .. })));
         assert!(matches!(
             load_inputs(&g, 0),
             Err(LoadError::Axes { got: 1, axes: 0 })
+        ));
+        // Two axes near ±2^31 LSB apart: a length of about 2^112 raw does not fit the offset.
+        let far = Segment {
+            length: 1 << 112,
+            shape: Shape::Line {
+                from: vec![0],
+                dir: vec![ONE],
+            },
+        };
+        assert!(matches!(
+            load_inputs(&far, 1),
+            Err(LoadError::Width { what: "length", .. })
+        ));
+        // A start near the top that the line carries past it.
+        let over = Segment {
+            length: 1 << 100,
+            shape: Shape::Line {
+                from: vec![(1 << 111) - (1 << 98)],
+                dir: vec![ONE],
+            },
+        };
+        assert!(matches!(
+            load_inputs(&over, 1),
+            Err(LoadError::Width {
+                what: "axis's reach",
+                ..
+            })
         ));
     }
 }
