@@ -1,6 +1,6 @@
 //! The Verilated path interpolator against its model, every output on every clock, under the
 //! random stream of `snapgen_sim::interp` (needs Verilator; the README's test command installs
-//! it): at one, three and eight axes, with no difference and every undisturbed computation of
+//! it): at every number of axes, with no difference and every undisturbed computation of
 //! a planner's segment equal to the rule; and a one-bit fault in any output is found at its
 //! clock (that shows the comparison and its report work; that the stream reaches the logic is
 //! shown by the disturbance counts and by the rule checks).
@@ -19,7 +19,17 @@ fn config(axes: u8, clocks: u64, seed: u64) -> InterpConfig {
 
 #[test]
 fn fabric_and_model_agree_on_every_clock() {
-    for (axes, clocks) in [(1, 1_000_000), (3, 5_000_000), (8, 4_000_000)] {
+    // 10^7 clocks in all, most at three axes and eight; every other count too.
+    for (axes, clocks) in [
+        (1, 1_000_000),
+        (2, 200_000),
+        (3, 5_000_000),
+        (4, 200_000),
+        (5, 200_000),
+        (6, 200_000),
+        (7, 200_000),
+        (8, 3_000_000),
+    ] {
         let lib = build_interpolator(axes, false).expect("the interpolator builds");
         let r = run(&lib.library, &config(axes, clocks, u64::from(axes))).expect("runs");
         assert_eq!(r.mismatch, None, "{axes} axes");
@@ -30,9 +40,10 @@ fn fabric_and_model_agree_on_every_clock() {
             r.computations > r.checked && r.segments > 100,
             "{axes} axes: {r:?}"
         );
-        // Every kind of disturbance happened, and segments of random bits.
+        // Every kind of disturbance happened (in the long runs; they are rare), and segments
+        // of random bits.
         assert!(
-            r.disturbances.iter().all(|&n| n > 0) && r.random_segments > 0,
+            (clocks < 1_000_000 || r.disturbances.iter().all(|&n| n > 0)) && r.random_segments > 0,
             "{axes} axes: {r:?}"
         );
         eprintln!("{axes} axes: {r:?}");
