@@ -308,6 +308,7 @@ with_io_top_ports!(block_table! { IO_TOP, "the I/O top (`snapgen_io`)"; });
 with_interpolator_ports!(
     block_table! { INTERPOLATOR, "the path interpolator (`snapgen_interpolator`)"; }
 );
+with_step_dir_ports!(block_table! { STEP_DIR, "the step/dir generator (`snapgen_step_dir`)"; });
 
 /// What a board pin is wired to in the board top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
