@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what snapgen's demo and tests need beside Rust, when it is missing: Verilator (the
-# co-simulation and the lint) and Yosys (synthesis), with apt-get (as root, or through sudo).
+# co-simulation and the lint), Yosys (synthesis) and Python's venv (for the routed-timing
+# check's nextpnr from PyPI), with apt-get (as root, or through sudo).
 # Sourced by scripts/demo.sh and scripts/test.sh; safe to run again (installs nothing twice).
 set -euo pipefail
 
@@ -11,6 +12,12 @@ fi
 need_apt=()
 command -v verilator >/dev/null 2>&1 || need_apt+=(verilator)
 command -v yosys >/dev/null 2>&1 || need_apt+=(yosys)
+# Python with venv and pip: scripts/route.sh installs nextpnr-ecp5 from PyPI into a venv.
+if ! command -v python3 >/dev/null 2>&1; then
+  need_apt+=(python3 python3-venv)
+elif ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+  need_apt+=(python3-venv)
+fi
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "installing ${need_apt[*]} with apt-get"
   SUDO=""
