@@ -6,7 +6,7 @@
 //! Its ports are the spec's `with_interpolator_ports!` list. The number of axes (1 to
 //! [`MAX_AXES`]) is chosen at generation; the per-axis memories are [`MAX_AXES`] words deep
 //! whatever it is, so an axis adds [`SHARE_BITS`]` + 2` clocks to a computation and no
-//! arithmetic. Its timing (no sum wider than 58 bits in a clock) and routed Fmax:
+//! arithmetic. Its timing (the wide sums split over two clocks) and routed Fmax:
 //! docs/PATH.md.
 //!
 //! rust-hdl 0.46 has no signed shifts, memories with run-time indices inside a clocked

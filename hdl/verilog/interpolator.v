@@ -9,9 +9,10 @@
 //   * the CORDIC (snapgen_model::path::cordic), one step per two clocks, its arctangents in a
 //     ROM.
 //
-// For routed timing no sum wider than SPLIT + 1 bits is formed in one clock: the accumulator's
-// sum is added low half then high half (the carry registered between them), as is each
-// product's use (base + product); a CORDIC step shifts on one clock and adds on the next.
+// For routed timing the wide sums take two clocks: the accumulator's sum is added low half
+// then high half (the carry registered between them), as is each product's use
+// (base + product); a CORDIC step shifts on one clock and adds (65 bits) on the next. The
+// widest sums left in one clock are the CORDIC's 65 bits and the angle's 64.
 //
 // Template: snapgen_hdl fills the values in double braces (the axes, the CORDIC's gain and
 // steps) and the //@ line (the arctangent ROM) from the model's constants, and puts the
