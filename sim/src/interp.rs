@@ -24,8 +24,9 @@ use snapgen_model::path::interp::{Path, Segment};
 use snapgen_model::{InterpInputs, InterpOutputs, FRAC_BITS};
 use snapgen_plan::path::{prepare, Element};
 
-use crate::layout::{harness_header, port_layout};
-use crate::verilated::{abi, VcdWindow, Verilated};
+use crate::layout::{first_difference, harness_header, port_layout};
+pub use crate::layout::{PortFault, PortMismatch};
+use crate::verilated::{abi, Verilated};
 use crate::SimError;
 
 snapgen_spec::with_interpolator_ports!(port_layout! {
@@ -45,21 +46,6 @@ pub fn interp_layout_header() -> String {
     )
 }
 
-/// One Verilated interpolator.
-pub struct FabricInterp(Verilated);
-
-impl FabricInterp {
-    /// Loads `library` and creates one interpolator; with `vcd`, a trace build.
-    pub fn open(library: &FsPath, vcd: Option<&VcdWindow>) -> Result<Self, SimError> {
-        Verilated::open(library, vcd, INTERP_TAG, IN_WORDS, OUT_WORDS).map(FabricInterp)
-    }
-
-    /// Runs one clock per `IN_WORDS` words of `ins`; `outs` receives each clock's outputs.
-    pub fn run(&mut self, ins: &[u32], outs: &mut Vec<u32>) {
-        self.0.run_each(ins, outs);
-    }
-}
-
 /// A run's settings.
 #[derive(Clone, Debug)]
 pub struct InterpConfig {
@@ -69,42 +55,9 @@ pub struct InterpConfig {
     pub clocks: u64,
     /// Seed of the stream.
     pub seed: u64,
-    /// Test hook: flip a bit of an output of the fabric's (see [`InterpFault`]).
-    pub fault: Option<InterpFault>,
-}
-
-/// A deliberate one-bit error in the fabric's outputs, to show that a difference is found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct InterpFault {
-    /// The clock.
-    pub clock: u64,
-    /// The output port (an index into [`INTERP_OUTPUTS`]).
-    pub port: usize,
-    /// The bit (modulo the port's width).
-    pub bit: u32,
-}
-
-/// The first output that differs.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct InterpMismatch {
-    /// Clock (from 0).
-    pub clock: u64,
-    /// The output port.
-    pub port: &'static str,
-    /// The model's bits.
-    pub expected: u128,
-    /// The fabric's bits.
-    pub actual: u128,
-}
-
-impl std::fmt::Display for InterpMismatch {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "first mismatch at clock {}: {} expected {:#x} got {:#x}",
-            self.clock, self.port, self.expected, self.actual
-        )
-    }
+    /// Test hook: flip a bit of an output of the fabric's (`port` indexes
+    /// [`INTERP_OUTPUTS`]).
+    pub fault: Option<PortFault>,
 }
 
 /// What a run did.
@@ -128,7 +81,7 @@ pub struct InterpReport {
     /// and resets while idle.
     pub disturbances: [u64; 5],
     /// The first difference between fabric and model, if any.
-    pub mismatch: Option<InterpMismatch>,
+    pub mismatch: Option<PortMismatch>,
 }
 
 /// A random path of `axes` axes from the planner: 1 to 6 lines and arcs (helices when there
@@ -360,7 +313,7 @@ pub fn run(library: &FsPath, cfg: &InterpConfig) -> Result<InterpReport, SimErro
             clocks: cfg.clocks,
         });
     }
-    let mut fabric = FabricInterp::open(library, None)?;
+    let mut fabric = Verilated::open(library, None, INTERP_TAG, IN_WORDS, OUT_WORDS)?;
     let mut model = Engine::new(cfg.axes);
     let mut stim = Stimulus {
         rng: rand::rngs::StdRng::seed_from_u64(cfg.seed),
@@ -384,46 +337,25 @@ pub fn run(library: &FsPath, cfg: &InterpConfig) -> Result<InterpReport, SimErro
             ins.extend_from_slice(&encode_inputs(&i));
             want.extend_from_slice(&encode_outputs(&model.outputs()));
         }
-        fabric.run(&ins, &mut got);
+        fabric.run_each(&ins, &mut got);
         if let Some(f) = cfg.fault {
-            if f.clock >= report.clocks && f.clock < report.clocks + n as u64 {
-                let at = (f.clock - report.clocks) as usize * OUT_WORDS;
-                let slot = OUT_SLOTS[f.port % OUT_SLOTS.len()];
-                let words = &mut got[at..at + OUT_WORDS];
-                let v = slot.get(words) ^ (1u128 << (f.bit % slot.bits));
-                slot.put(words, v);
-            }
+            f.apply(&OUT_SLOTS, OUT_WORDS, report.clocks, &mut got);
         }
         if got != want {
-            report.mismatch = Some(locate(report.clocks, &got, &want));
+            report.mismatch = first_difference(
+                &INTERP_OUTPUTS,
+                &OUT_SLOTS,
+                OUT_WORDS,
+                report.clocks,
+                &got,
+                &want,
+            );
             report.clocks += n as u64;
             return Ok(report);
         }
         report.clocks += n as u64;
     }
     Ok(report)
-}
-
-/// The first clock and port where a batch's words differ.
-fn locate(first: u64, got: &[u32], want: &[u32]) -> InterpMismatch {
-    for (c, (g, w)) in got
-        .chunks(OUT_WORDS)
-        .zip(want.chunks(OUT_WORDS))
-        .enumerate()
-    {
-        for (p, slot) in INTERP_OUTPUTS.iter().zip(&OUT_SLOTS) {
-            let (a, e) = (slot.get(g), slot.get(w));
-            if a != e {
-                return InterpMismatch {
-                    clock: first + c as u64,
-                    port: p.name,
-                    expected: e,
-                    actual: a,
-                };
-            }
-        }
-    }
-    unreachable!("the words differ in a port's bits: the fabric writes no other bit")
 }
 
 #[cfg(test)]

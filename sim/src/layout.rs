@@ -118,6 +118,12 @@ impl Slot {
         }
     }
 
+    /// Flips bit `bit` (modulo its width) of the port in `w`.
+    pub fn flip(&self, w: &mut [u32], bit: u32) {
+        let v = self.get(w) ^ (1u128 << (bit % self.bits));
+        self.put(w, v);
+    }
+
     /// Writes `v` (its low `bits` bits) into `w` (ports of at most 128 bits).
     #[inline(always)]
     pub fn put(&self, w: &mut [u32], v: u128) {
@@ -132,6 +138,80 @@ impl Slot {
             }
         }
     }
+}
+
+/// A deliberate one-bit error in a block's outputs (a test hook of every lockstep), to show
+/// that a difference is found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PortFault {
+    /// The clock.
+    pub clock: u64,
+    /// The output port (an index into the block's output table).
+    pub port: usize,
+    /// The bit (modulo the port's width).
+    pub bit: u32,
+}
+
+impl PortFault {
+    /// Flips its bit in `got`, a batch of clocks of `slots.len()` ports' output words
+    /// (`words` a clock) beginning at clock `first`, when its clock is in the batch.
+    pub fn apply(&self, slots: &[Slot], words: usize, first: u64, got: &mut [u32]) {
+        let clocks = (got.len() / words) as u64;
+        if self.clock >= first && self.clock < first + clocks {
+            let at = (self.clock - first) as usize * words;
+            slots[self.port % slots.len()].flip(&mut got[at..at + words], self.bit);
+        }
+    }
+}
+
+/// The first output that differs between a fabric and its model.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PortMismatch {
+    /// Clock (from 0).
+    pub clock: u64,
+    /// The output port.
+    pub port: &'static str,
+    /// The model's bits.
+    pub expected: u128,
+    /// The fabric's bits.
+    pub actual: u128,
+}
+
+impl std::fmt::Display for PortMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "first mismatch at clock {}: {} expected {:#x} got {:#x}",
+            self.clock, self.port, self.expected, self.actual
+        )
+    }
+}
+
+/// The first clock and port where a batch of the fabric's output words (`got`) differs from
+/// the model's (`want`): clocks of `words` words beginning at clock `first`, the ports of
+/// `ports` at `slots` (ports of at most 128 bits).
+pub fn first_difference(
+    ports: &[Port],
+    slots: &[Slot],
+    words: usize,
+    first: u64,
+    got: &[u32],
+    want: &[u32],
+) -> Option<PortMismatch> {
+    got.chunks(words)
+        .zip(want.chunks(words))
+        .enumerate()
+        .find_map(|(c, (g, w))| {
+            ports.iter().zip(slots).find_map(|(p, s)| {
+                let (actual, expected) = (s.get(g), s.get(w));
+                (actual != expected).then_some(PortMismatch {
+                    clock: first + c as u64,
+                    port: p.name,
+                    expected,
+                    actual,
+                })
+            })
+        })
 }
 
 /// Where port `k` of `ports` goes, and the words used up to and including it.

@@ -18,7 +18,8 @@ use rand::{Rng, SeedableRng};
 use snapgen_model::io::step_dir::{max_steps_per_second, safe_steps_per_second, StepDir};
 use snapgen_model::{StepDirInputs, StepDirOutputs};
 
-use crate::layout::{harness_header, port_layout};
+use crate::layout::{first_difference, harness_header, port_layout};
+pub use crate::layout::{PortFault, PortMismatch};
 use crate::verilated::{abi, Verilated};
 use crate::SimError;
 
@@ -56,8 +57,8 @@ pub struct StepDirReport {
     pub flagged: u64,
     /// Runs within the limit that raised `overrun` (must be 0).
     pub false_overruns: u64,
-    /// The first clock where fabric and model differ: (clock, output, model, fabric).
-    pub mismatch: Option<(u64, &'static str, u128, u128)>,
+    /// The first difference between fabric and model, if any.
+    pub mismatch: Option<PortMismatch>,
     /// What the drive's view found wrong, first only.
     pub violation: Option<String>,
 }
@@ -130,13 +131,13 @@ impl Drive {
 }
 
 /// Runs `clocks` clocks of the stream from `seed` on the library `library` (built by
-/// [`crate::build::build_step_dir`]); `fault` (a test hook) flips bit `.2` of output `.1`
-/// (an index into [`STEP_DIR_OUTPUTS`]) of the fabric's at clock `.0`.
+/// [`crate::build::build_step_dir`]); `fault` (a test hook) flips a bit of one of the
+/// fabric's outputs (`port` indexes [`STEP_DIR_OUTPUTS`]).
 pub fn run(
     library: &FsPath,
     clocks: u64,
     seed: u64,
-    fault: Option<(u64, usize, u32)>,
+    fault: Option<PortFault>,
 ) -> Result<StepDirReport, SimError> {
     let mut fabric = Verilated::open(library, None, STEP_DIR_TAG, IN_WORDS, OUT_WORDS)?;
     let slot = |name: &str| {
@@ -213,30 +214,22 @@ pub fn run(
             want.extend_from_slice(&encode_outputs(&model.outputs()));
         }
         fabric.run_each(&ins, &mut got);
-        if let Some((at, port, bit)) = fault {
-            if at >= r.clocks && at < r.clocks + lines_in.len() as u64 {
-                let base = (at - r.clocks) as usize * OUT_WORDS;
-                let slot = OUT_SLOTS[port % OUT_SLOTS.len()];
-                let words = &mut got[base..base + OUT_WORDS];
-                let v = slot.get(words) ^ (1u128 << (bit % slot.bits));
-                slot.put(words, v);
-            }
+        if let Some(f) = fault {
+            f.apply(&OUT_SLOTS, OUT_WORDS, r.clocks, &mut got);
         }
         if got != want {
-            for (c, (g, w)) in got
-                .chunks(OUT_WORDS)
-                .zip(want.chunks(OUT_WORDS))
-                .enumerate()
-            {
-                if let Some((p, s)) = STEP_DIR_OUTPUTS
-                    .iter()
-                    .zip(&OUT_SLOTS)
-                    .find(|(_, s)| s.get(g) != s.get(w))
-                {
-                    r.mismatch = Some((r.clocks + c as u64, p.name, s.get(w), s.get(g)));
-                    r.clocks += c as u64 + 1;
-                    return Ok(r);
-                }
+            let m = first_difference(
+                &STEP_DIR_OUTPUTS,
+                &OUT_SLOTS,
+                OUT_WORDS,
+                r.clocks,
+                &got,
+                &want,
+            );
+            if let Some(m) = m {
+                r.clocks = m.clock + 1;
+                r.mismatch = Some(m);
+                return Ok(r);
             }
         }
         // The drive's view of the fabric's own lines.

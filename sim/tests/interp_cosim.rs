@@ -6,7 +6,7 @@
 //! shown by the disturbance counts and by the rule checks).
 
 use snapgen_sim::build::{build_interpolator, build_interpolator_from};
-use snapgen_sim::interp::{run, InterpConfig, InterpFault, INTERP_OUTPUTS};
+use snapgen_sim::interp::{run, InterpConfig, PortFault, INTERP_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> InterpConfig {
     InterpConfig {
@@ -56,7 +56,7 @@ fn a_one_bit_fault_in_any_output_is_found() {
     for (port, p) in INTERP_OUTPUTS.iter().enumerate() {
         for (clock, bit) in [(1_234, 0), (57_001, p.bits - 1)] {
             let mut cfg = config(3, 60_000, 9);
-            cfg.fault = Some(InterpFault { clock, port, bit });
+            cfg.fault = Some(PortFault { clock, port, bit });
             let r = run(&lib.library, &cfg).expect("runs");
             let m = r
                 .mismatch

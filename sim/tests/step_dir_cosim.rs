@@ -2,7 +2,7 @@
 //! lines as a drive sees them (needs Verilator; the README's test command installs it).
 
 use snapgen_sim::build::build_step_dir;
-use snapgen_sim::step_dir::{run, STEP_DIR_OUTPUTS};
+use snapgen_sim::step_dir::{run, PortFault, STEP_DIR_OUTPUTS};
 
 #[test]
 fn fabric_model_and_drive_agree() {
@@ -22,9 +22,14 @@ fn fabric_model_and_drive_agree() {
 fn a_one_bit_fault_in_any_output_is_found() {
     let lib = build_step_dir(false).expect("the generator builds");
     for (port, p) in STEP_DIR_OUTPUTS.iter().enumerate() {
-        let r = run(&lib.library, 200_000, 2, Some((40_123, port, p.bits - 1))).expect("runs");
-        let (clock, name, want, got) = r.mismatch.unwrap_or_else(|| panic!("{} not found", p.name));
-        assert_eq!((clock, name), (40_123, p.name));
-        assert_eq!(want ^ got, 1 << (p.bits - 1));
+        let fault = PortFault {
+            clock: 40_123,
+            port,
+            bit: p.bits - 1,
+        };
+        let r = run(&lib.library, 200_000, 2, Some(fault)).expect("runs");
+        let m = r.mismatch.unwrap_or_else(|| panic!("{} not found", p.name));
+        assert_eq!((m.clock, m.port), (40_123, p.name));
+        assert_eq!(m.expected ^ m.actual, 1 << (p.bits - 1));
     }
 }

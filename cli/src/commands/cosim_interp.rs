@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use snapgen_sim::build::build_interpolator;
-use snapgen_sim::interp::{self, InterpConfig, InterpFault, INTERP_OUTPUTS};
+use snapgen_sim::interp::{self, InterpConfig, PortFault, INTERP_OUTPUTS};
 
 use crate::error::{split_fault, InputError, Mismatched};
 
@@ -61,11 +61,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn parse_fault(s: &str) -> Result<InterpFault, InputError> {
+fn parse_fault(s: &str) -> Result<PortFault, InputError> {
     let (clock, name, bit) = split_fault::<String>(s)?;
     let port = INTERP_OUTPUTS
         .iter()
         .position(|p| p.name == name)
         .ok_or_else(|| InputError::Fault(s.to_string()))?;
-    Ok(InterpFault { clock, port, bit })
+    Ok(PortFault { clock, port, bit })
 }

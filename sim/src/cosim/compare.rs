@@ -47,9 +47,7 @@ impl Register {
 
     /// Flips bit `bit` (modulo its width) of this register in a clock's output words.
     pub fn flip(self, words: &mut [u32], bit: u32) {
-        let slot = OUT_SLOTS[self.0];
-        let v = slot.get(words) ^ (1u128 << (bit % self.bits()));
-        slot.put(words, v);
+        OUT_SLOTS[self.0].flip(words, bit);
     }
 }
 
