@@ -11,6 +11,8 @@
 //!   [`crate::path::engine`]) for one clock.
 //! * [`StepDirInputs`], [`StepDirOutputs`]: the step/dir generator (`snapgen_step_dir`,
 //!   [`crate::io::step_dir`]) for one clock.
+//! * [`PathSeqInputs`], [`PathSeqOutputs`]: the path sequencer (`snapgen_path_sequencer`,
+//!   [`crate::path::sequencer`]) for one clock.
 
 /// A block's inputs and outputs as two structs.
 macro_rules! port_structs {
@@ -43,6 +45,9 @@ snapgen_spec::with_interpolator_ports!(port_structs! {
 });
 snapgen_spec::with_step_dir_ports!(port_structs! {
     StepDirInputs, StepDirOutputs, "the step/dir generator";
+});
+snapgen_spec::with_path_sequencer_ports!(port_structs! {
+    PathSeqInputs, PathSeqOutputs, "the path sequencer";
 });
 
 /// The core's `command` inputs and `status` outputs as structs of their own.

@@ -247,6 +247,87 @@ macro_rules! with_interpolator_ports {
     };
 }
 
+/// Calls `$callback! { $($extra)* <the path sequencer's ports> }` (see the module
+/// documentation): the ring of path segments and, on each tick, the choice of the segment the
+/// path length lies in and the interpolator's load and start
+/// (`snapgen_model::path::sequencer`, issue 22). Its `interpolator` outputs are the
+/// interpolator's inputs of the same names; its `done` input is the interpolator's `done`.
+#[macro_export]
+macro_rules! with_path_sequencer_ports {
+    ($callback:ident ! { $($extra:tt)* }) => {
+        $callback! { $($extra)*
+            clock: "Fabric clock.";
+            inputs {
+                reset {
+                    reset: bit[1] bool, "Synchronous reset, active high: the path is empty (segment 0 is the next written), idle, the flags cleared.";
+                }
+                write {
+                    seg_index: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the writes below are for (wrapping index; accepted after the path's last segment and within the ring ahead of the current one, else `refused`).";
+                    write_span: bit[1] bool, "Write the segment's span (`seg_start`, `seg_length`).";
+                    seg_start: bits[$crate::widths::X_BITS] i128, "The path length at the segment's start, raw (the chain's position format).";
+                    seg_length: bits[$crate::widths::X_BITS] i128, "The segment's length, raw (≥ 0).";
+                    write_shape: bit[1] bool, "Write the segment's shape (the `seg_` fields below, as the interpolator's shape ports).";
+                    seg_arc: bit[1] bool, "The segment is an arc (or a helix); otherwise a line.";
+                    seg_ccw: bit[1] bool, "The arc turns counter-clockwise.";
+                    seg_plane_first: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's first axis.";
+                    seg_plane_second: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's second axis.";
+                    seg_centre_first: bits[$crate::widths::X_BITS] i128, "The arc's centre on the first plane axis, raw.";
+                    seg_centre_second: bits[$crate::widths::X_BITS] i128, "The arc's centre on the second plane axis, raw.";
+                    seg_radius: bits[$crate::widths::X_BITS] i128, "The arc's radius at its start, raw.";
+                    seg_growth: bits[$crate::widths::SHARE_BITS] i128, "The radius's change per raw unit of the path length (62 fraction bits).";
+                    seg_start_angle: bits[$crate::widths::TURN_BITS] u64, "The arc's angle at its start (a turn is 2^64).";
+                    seg_rate: bits[$crate::widths::RATE_BITS] i128, "The arc's turns·2^64 per raw unit of the path length, 120 fraction bits.";
+                    write_axis: bit[1] bool, "Write the segment's axis `seg_axis` (`seg_from`, `seg_share`); an axis the design does not have is `refused`.";
+                    seg_axis: bits[$crate::widths::AXIS_BITS] u8, "The axis written.";
+                    seg_from: bits[$crate::widths::X_BITS] i128, "The axis at the segment's start, raw.";
+                    seg_share: bits[$crate::widths::SHARE_BITS] i128, "The axis's share of the length (62 fraction bits).";
+                }
+                extend {
+                    extend: bit[1] bool, "The path now ends with segment `seg_index` (it and those before it written; accepted ahead of the last and within the ring, else `refused`).";
+                }
+                tick {
+                    tick: bit[1] bool, "A tick: commit the last computation's axes and compute those at `s` (one-clock pulse).";
+                    s: bits[$crate::widths::X_BITS] i128, "The path length at this tick, raw (the chain's position register), read with `tick`.";
+                }
+                interpolator {
+                    done: bit[1] bool, "The interpolator's `done`.";
+                }
+            }
+            outputs {
+                interpolator {
+                    load_shape: bit[1] bool, "Load the shape below into the interpolator.";
+                    arc: bit[1] bool, "The segment is an arc.";
+                    ccw: bit[1] bool, "The arc turns counter-clockwise.";
+                    plane_first: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's first axis.";
+                    plane_second: bits[$crate::widths::AXIS_BITS] u8, "The arc plane's second axis.";
+                    centre_first: bits[$crate::widths::X_BITS] i128, "The arc's centre on the first plane axis.";
+                    centre_second: bits[$crate::widths::X_BITS] i128, "The arc's centre on the second plane axis.";
+                    radius: bits[$crate::widths::X_BITS] i128, "The arc's radius at its start.";
+                    growth: bits[$crate::widths::SHARE_BITS] i128, "The radius's change per raw unit of the path length.";
+                    start_angle: bits[$crate::widths::TURN_BITS] u64, "The arc's angle at its start.";
+                    rate: bits[$crate::widths::RATE_BITS] i128, "The arc's angular rate.";
+                    load_axis: bit[1] bool, "Load axis `axis` below into the interpolator.";
+                    axis: bits[$crate::widths::AXIS_BITS] u8, "The axis loaded.";
+                    from: bits[$crate::widths::X_BITS] i128, "The axis at the segment's start.";
+                    share: bits[$crate::widths::SHARE_BITS] i128, "The axis's share of the length.";
+                    start: bit[1] bool, "Start the interpolator at `offset` (one-clock pulse).";
+                    offset: bits[$crate::widths::X_BITS] i128, "The distance into the segment (clamped: see the model).";
+                }
+                axes {
+                    commit: bit[1] bool, "The axes the interpolator wrote since the last commit are the positions at the tick before: take them (one clock, on a tick).";
+                }
+                status {
+                    segment: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the sequencer is on.";
+                    running: bit[1] bool, "A seek, load or computation runs.";
+                    empty: bit[1] bool, "No segment yet (since reset).";
+                    late: bit[1] bool, "A tick came while a computation ran (it was dropped and the axes held; sticky until reset).";
+                    refused: bit[1] bool, "A write or extension was refused (sticky until reset).";
+                }
+            }
+        }
+    };
+}
+
 /// Calls `$callback! { $($extra)* <the step/dir generator's ports> }` (see the module
 /// documentation): one axis's stepper-drive output, made from its whole-LSB position
 /// (`snapgen_model::io::step_dir`, issue 22).
@@ -309,6 +390,9 @@ with_interpolator_ports!(
     block_table! { INTERPOLATOR, "the path interpolator (`snapgen_interpolator`)"; }
 );
 with_step_dir_ports!(block_table! { STEP_DIR, "the step/dir generator (`snapgen_step_dir`)"; });
+with_path_sequencer_ports!(
+    block_table! { PATH_SEQUENCER, "the path sequencer (`snapgen_path_sequencer`)"; }
+);
 
 /// What a board pin is wired to in the board top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -417,7 +501,7 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_sections_known() {
-        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR, STEP_DIR] {
+        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR, STEP_DIR, PATH_SEQUENCER] {
             let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
             names.push(b.clock);
             let n = names.len();
@@ -429,6 +513,27 @@ mod tests {
         assert_eq!(MOTION_CORE.port("x").map(|p| p.bits), Some(112));
         assert_eq!(MOTION_CORE.section("command").count(), 12);
         assert_eq!(IO_TOP.port("status").map(|p| p.bits), Some(240));
+    }
+
+    #[test]
+    fn the_sequencer_drives_every_interpolator_input_but_its_reset() {
+        // Wired by name in a design: each `interpolator` output of the sequencer is the
+        // interpolator's input of that name and width, and every such input is driven.
+        let driven: Vec<&Port> = PATH_SEQUENCER.section("interpolator").collect();
+        for p in &driven {
+            let q = INTERPOLATOR.port(p.name);
+            let q = q.unwrap_or_else(|| panic!("{} is no interpolator port", p.name));
+            let opposite = if p.dir == Dir::Out { Dir::In } else { Dir::Out };
+            assert_eq!((q.dir, q.bits), (opposite, p.bits), "{}", p.name);
+        }
+        let inputs = INTERPOLATOR.ports.iter().filter(|p| p.dir == Dir::In);
+        for q in inputs.filter(|q| q.name != "reset") {
+            assert!(
+                driven.iter().any(|p| p.name == q.name),
+                "{} is not driven",
+                q.name
+            );
+        }
     }
 
     #[test]

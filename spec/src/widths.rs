@@ -57,6 +57,14 @@ pub const RATE_FRAC: u32 = 120;
 /// Width of an angle: a full turn is `2^TURN_BITS`.
 pub const TURN_BITS: u32 = 64;
 
+/// Width of a path segment's index in the path sequencer (wrapping: a path may have any number
+/// of segments; the sequencer compares indices by wrapping differences).
+pub const PATH_INDEX_BITS: u32 = 16;
+/// Width of a segment's slot in the path sequencer's ring of segments.
+pub const PATH_SLOT_BITS: u32 = 6;
+/// Segments the path sequencer holds at once (its ring's depth).
+pub const PATH_SLOTS: u32 = 1 << PATH_SLOT_BITS;
+
 /// Width of the step/dir generator's step length and its pulse timers (clocks).
 pub const STEP_TIMER_BITS: u32 = 16;
 
@@ -76,6 +84,7 @@ const _: () = {
     assert!(X_BITS > V_BITS && X_BITS <= 127 && X_BITS >= FRAC_BITS + POSITION_BITS);
     assert!(bytes_for(V_BITS) == WIDE_BYTES);
     assert!(MAX_AXES == 1 << AXIS_BITS);
+    assert!(PATH_SLOT_BITS < PATH_INDEX_BITS - 1 && PATH_INDEX_BITS <= 16);
 };
 
 /// The largest value of a register of `bits` bits: two's complement when `signed`.

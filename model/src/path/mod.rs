@@ -2,10 +2,12 @@
 //! path length `s`, integrated by the chain, becomes each axis's position.
 //!
 //! Built so far: [`interp`], the interpolator's rules for lines, arcs and helices,
-//! [`cordic`], the integer sine and cosine it uses, and [`engine`], the fabric's interpolator
-//! clock by clock. The path sequencer, the group stop and the N-axis fabric are not built yet
-//! (issue 22).
+//! [`cordic`], the integer sine and cosine it uses, [`engine`], the fabric's interpolator
+//! clock by clock, and [`sequencer`], the fabric's ring of segments that finds the segment of
+//! each tick's path length and starts the interpolator on it. The group stop and the N-axis
+//! fabric around them are not built yet (issue 22).
 
 pub mod cordic;
 pub mod engine;
 pub mod interp;
+pub mod sequencer;
