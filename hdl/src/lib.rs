@@ -32,6 +32,7 @@ pub mod input_filter;
 pub mod interpolator;
 pub mod io_top;
 pub mod netlist;
+pub mod path_sequencer;
 pub mod payload_shift;
 pub mod program_memory;
 pub mod protocol_v;

@@ -166,6 +166,28 @@ pub fn build_interpolator_from(verilog: &str, trace: bool) -> Result<Built, SimE
     )
 }
 
+/// Builds (or finds in the cache) the library of the path sequencer for `axes` axes
+/// ([`crate::path_seq`]), with VCD tracing if `trace`.
+pub fn build_path_sequencer(axes: u8, trace: bool) -> Result<Built, SimError> {
+    build_path_sequencer_from(
+        &snapgen_hdl::path_sequencer::path_sequencer_verilog(axes),
+        trace,
+    )
+}
+
+/// Builds the path sequencer's library from the Verilog `verilog` (the generator's, or a
+/// deliberately altered copy).
+pub fn build_path_sequencer_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "path-seq",
+        snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX,
+        verilog,
+        HARNESS_CPP,
+        &crate::path_seq::path_seq_layout_header(),
+        trace,
+    )
+}
+
 /// Builds (or finds in the cache) the library of the step/dir generator ([`crate::step_dir`]),
 /// with VCD tracing if `trace`.
 pub fn build_step_dir(trace: bool) -> Result<Built, SimError> {

@@ -86,7 +86,7 @@ pub struct InterpReport {
 
 /// A random path of `axes` axes from the planner: 1 to 6 lines and arcs (helices when there
 /// are more than two axes) from a random start, within ±2^30 output LSBs.
-fn random_path(rng: &mut impl Rng, axes: usize) -> Option<Path> {
+pub(crate) fn random_path(rng: &mut impl Rng, axes: usize) -> Option<Path> {
     let mut at: Vec<i64> = (0..axes)
         .map(|_| rng.gen_range(-(1 << 30)..1 << 30))
         .collect();

@@ -11,8 +11,8 @@
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
 //! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
 //!   model under random command streams; [`board`] is the virtual board on it.
-//! * [`interp`] runs the path interpolator in lockstep with its model, [`step_dir`] the
-//!   step/dir generator (issue 22).
+//! * [`interp`] runs the path interpolator in lockstep with its model, [`path_seq`] the path
+//!   sequencer, [`step_dir`] the step/dir generator (issue 22).
 
 pub mod board;
 pub mod build;
@@ -25,6 +25,7 @@ pub mod io;
 pub mod io_cosim;
 pub mod layout;
 pub mod moves;
+pub mod path_seq;
 pub mod step_dir;
 pub mod vcd;
 pub mod verilated;
@@ -74,6 +75,9 @@ pub enum SimError {
         /// Clocks session 0 ran.
         clocks: u64,
     },
+    /// A run's settings are not possible (see the message).
+    #[error("{0}")]
+    Config(String),
     /// The built library does not load or does not match this harness.
     #[error("cannot load the co-simulation library {path}: {reason}")]
     Load {

@@ -107,17 +107,20 @@ pub struct ShapeWord {
     pub rate: i128,
 }
 
-/// The sequencer's registers and memories.
+/// The ring's memories (block RAM in the fabric).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct PathSequencer {
-    /// Axes of the design (1 to [`MAX_AXES`], fixed at generation).
-    axes: u8,
+struct Ring {
     /// Spans: (start, length) per slot.
-    span_mem: Vec<(i128, i128)>,
+    span: Vec<(i128, i128)>,
     /// Shapes per slot.
-    shape_mem: Vec<ShapeWord>,
+    shape: Vec<ShapeWord>,
     /// (from, share) per slot and axis (`slot · MAX_AXES + axis`).
-    axis_mem: Vec<(i128, i128)>,
+    axis: Vec<(i128, i128)>,
+}
+
+/// The sequencer's registers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Registers {
     /// State.
     pub state: State,
     /// The current segment.
@@ -128,7 +131,7 @@ pub struct PathSequencer {
     pub last: u16,
     /// No segment has been forgotten since reset (`oldest` is the path's first).
     pub whole: bool,
-    /// The interpolator holds segment [`PathSequencer::loaded`].
+    /// The interpolator holds segment [`Registers::loaded`].
     pub loaded_valid: bool,
     /// The segment the interpolator holds.
     pub loaded: u16,
@@ -140,7 +143,7 @@ pub struct PathSequencer {
     pub span_q: (i128, i128),
     /// The shape read.
     pub shape_q: ShapeWord,
-    /// The axis word read, and its axis.
+    /// The axis word read.
     pub axis_q: (i128, i128),
     /// The axis whose word is read next.
     pub a_read: u8,
@@ -152,6 +155,17 @@ pub struct PathSequencer {
     pub past: i128,
     /// The low half of a difference, and its borrow (the fabric's split; see [`SPLIT`]).
     pub low: (u128, bool),
+}
+
+/// The path sequencer: its memories, registers and outputs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PathSequencer {
+    /// Axes of the design (1 to [`MAX_AXES`], fixed at generation).
+    axes: u8,
+    /// The ring.
+    ring: Ring,
+    /// The registers.
+    pub reg: Registers,
     /// The outputs' registers.
     out: PathSeqOutputs,
 }
@@ -186,26 +200,30 @@ impl PathSequencer {
         let slots = PATH_SLOTS as usize;
         Ok(PathSequencer {
             axes,
-            span_mem: vec![(0, 0); slots],
-            shape_mem: vec![ShapeWord::default(); slots],
-            axis_mem: vec![(0, 0); slots * MAX_AXES as usize],
-            state: State::Idle,
-            k: 0,
-            oldest: 0,
-            last: u16::MAX,
-            whole: true,
-            loaded_valid: false,
-            loaded: 0,
-            fresh: false,
-            s: 0,
-            span_q: (0, 0),
-            shape_q: ShapeWord::default(),
-            axis_q: (0, 0),
-            a_read: 0,
-            a_q: 0,
-            r: 0,
-            past: 0,
-            low: (0, false),
+            ring: Ring {
+                span: vec![(0, 0); slots],
+                shape: vec![ShapeWord::default(); slots],
+                axis: vec![(0, 0); slots * MAX_AXES as usize],
+            },
+            reg: Registers {
+                state: State::Idle,
+                k: 0,
+                oldest: 0,
+                last: u16::MAX,
+                whole: true,
+                loaded_valid: false,
+                loaded: 0,
+                fresh: false,
+                s: 0,
+                span_q: (0, 0),
+                shape_q: ShapeWord::default(),
+                axis_q: (0, 0),
+                a_read: 0,
+                a_q: 0,
+                r: 0,
+                past: 0,
+                low: (0, false),
+            },
             out: PathSeqOutputs {
                 empty: true,
                 ..Default::default()
@@ -249,25 +267,26 @@ impl PathSequencer {
 
     /// One clock edge with inputs `i`.
     pub fn clock(&mut self, i: &PathSeqInputs) {
-        let old = self.clone();
+        let old = self.reg;
         // Registered memory reads (the value before this clock's writes).
         let slot = Self::slot(old.k);
-        self.span_q = old.span_mem[slot];
-        self.shape_q = old.shape_mem[slot];
-        self.axis_q = old.axis_mem[slot * MAX_AXES as usize + usize::from(old.a_read)];
-        self.a_q = old.a_read;
+        let r = &mut self.reg;
+        r.span_q = self.ring.span[slot];
+        r.shape_q = self.ring.shape[slot];
+        r.axis_q = self.ring.axis[slot * MAX_AXES as usize + usize::from(old.a_read)];
+        r.a_q = old.a_read;
         self.out.load_shape = false;
         self.out.load_axis = false;
         self.out.start = false;
         self.out.commit = false;
         if i.reset {
-            self.state = State::Idle;
-            self.k = 0;
-            self.oldest = 0;
-            self.last = u16::MAX;
-            self.whole = true;
-            self.loaded_valid = false;
-            self.fresh = false;
+            r.state = State::Idle;
+            r.k = 0;
+            r.oldest = 0;
+            r.last = u16::MAX;
+            r.whole = true;
+            r.loaded_valid = false;
+            r.fresh = false;
             self.out.late = false;
             self.out.refused = false;
         } else {
@@ -278,7 +297,7 @@ impl PathSequencer {
     }
 
     /// The host's side: writes and extensions, judged on the registers before the clock.
-    fn write(&mut self, old: &PathSequencer, i: &PathSeqInputs) {
+    fn write(&mut self, old: &Registers, i: &PathSeqInputs) {
         let index = i.seg_index;
         let slots = PATH_SLOTS as u16;
         let forward = |d: u16| d != 0 && d < 1 << 15;
@@ -289,10 +308,10 @@ impl PathSequencer {
         if any && in_ring && axis_ok {
             let slot = Self::slot(index);
             if i.write_span {
-                self.span_mem[slot] = (wrap(i.seg_start, X_BITS), wrap(i.seg_length, X_BITS));
+                self.ring.span[slot] = (wrap(i.seg_start, X_BITS), wrap(i.seg_length, X_BITS));
             }
             if i.write_shape {
-                self.shape_mem[slot] = ShapeWord {
+                self.ring.shape[slot] = ShapeWord {
                     arc: i.seg_arc,
                     ccw: i.seg_ccw,
                     plane_first: i.seg_plane_first & ((1 << AXIS_BITS) - 1),
@@ -306,20 +325,20 @@ impl PathSequencer {
                 };
             }
             if i.write_axis {
-                self.axis_mem[slot * MAX_AXES as usize + usize::from(axis)] =
+                self.ring.axis[slot * MAX_AXES as usize + usize::from(axis)] =
                     (wrap(i.seg_from, X_BITS), wrap(i.seg_share, SHARE_BITS));
             }
             if ahead(index, old.oldest) >= slots {
                 // The slot held segment `index − PATH_SLOTS`: forgotten.
-                self.oldest = index.wrapping_sub(slots - 1);
-                self.whole = false;
+                self.reg.oldest = index.wrapping_sub(slots - 1);
+                self.reg.whole = false;
             }
         } else if any {
             self.out.refused = true;
         }
         if i.extend {
             if forward(ahead(index, old.last)) && ahead(index, old.oldest) < slots {
-                self.last = index;
+                self.reg.last = index;
             } else {
                 self.out.refused = true;
             }
@@ -327,7 +346,9 @@ impl PathSequencer {
     }
 
     /// The state machine (registers read from `old`, as a clock edge does).
-    fn advance(&mut self, old: &PathSequencer, i: &PathSeqInputs) {
+    fn advance(&mut self, old: &Registers, i: &PathSeqInputs) {
+        let axes = self.axes;
+        let (r, out) = (&mut self.reg, &mut self.out);
         let cell = 1i128 << FRAC_BITS;
         // Whole cells of a value (its top 32 bits, signed).
         let cells = |x: i128| x >> FRAC_BITS;
@@ -337,51 +358,51 @@ impl PathSequencer {
             State::Idle => {
                 if i.tick {
                     if old.fresh {
-                        self.out.commit = true;
-                        self.fresh = false;
+                        out.commit = true;
+                        r.fresh = false;
                     }
                     if !empty {
-                        self.s = wrap(i.s, X_BITS);
-                        self.state = State::Read;
+                        r.s = wrap(i.s, X_BITS);
+                        r.state = State::Read;
                     }
                 }
             }
-            State::Read => self.state = State::OffsetLow,
+            State::Read => r.state = State::OffsetLow,
             State::OffsetLow => {
                 let d = half(old.s) as i128 - half(old.span_q.0) as i128;
-                self.low = (half(d), d < 0);
-                self.state = State::OffsetHigh;
+                r.low = (half(d), d < 0);
+                r.state = State::OffsetHigh;
             }
             State::OffsetHigh => {
-                self.r = wrap(old.s - old.span_q.0, X_BITS);
-                self.state = State::PastLow;
+                r.r = wrap(old.s - old.span_q.0, X_BITS);
+                r.state = State::PastLow;
             }
             State::PastLow => {
                 let d = half(old.r) as i128 - half(old.span_q.1) as i128;
-                self.low = (half(d), d < 0);
-                self.state = State::PastHigh;
+                r.low = (half(d), d < 0);
+                r.state = State::PastHigh;
             }
             State::PastHigh => {
-                self.past = wrap(old.r - old.span_q.1, X_BITS);
-                self.state = State::Decide;
+                r.past = wrap(old.r - old.span_q.1, X_BITS);
+                r.state = State::Decide;
             }
             State::Decide => {
                 let (at_oldest, at_last) = (old.k == old.oldest, old.k == old.last);
                 let below = old.r < 0;
                 let beyond = old.past >= 0;
                 if below && !at_oldest {
-                    self.k = old.k.wrapping_sub(1);
-                    self.state = State::Read;
+                    r.k = old.k.wrapping_sub(1);
+                    r.state = State::Read;
                 } else if beyond && !at_last {
-                    self.k = old.k.wrapping_add(1);
-                    self.state = State::Read;
+                    r.k = old.k.wrapping_add(1);
+                    r.state = State::Read;
                 } else {
                     let first = at_oldest && old.whole;
                     // Below a cell before the first segment's start, or below any other's.
                     let under = if first { cells(old.r) < -1 } else { below };
                     // More than a cell beyond the last segment's end.
                     let over = at_last && cells(old.past) >= 1 && old.past != cell;
-                    self.out.offset = if under {
+                    out.offset = if under {
                         if first {
                             -cell
                         } else {
@@ -392,48 +413,48 @@ impl PathSequencer {
                     } else {
                         old.r
                     };
-                    self.a_read = 0;
+                    r.a_read = 0;
                     if old.loaded_valid && old.loaded == old.k {
-                        self.out.start = true;
-                        self.state = State::Wait;
+                        out.start = true;
+                        r.state = State::Wait;
                     } else {
-                        self.out.load_shape = true;
-                        self.loaded_valid = true;
-                        self.loaded = old.k;
-                        self.state = State::LoadShape;
+                        out.load_shape = true;
+                        r.loaded_valid = true;
+                        r.loaded = old.k;
+                        r.state = State::LoadShape;
                     }
                 }
             }
             State::LoadShape => {
-                self.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
-                self.out.load_axis = true;
-                self.state = State::LoadAxis;
+                r.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
+                out.load_axis = true;
+                r.state = State::LoadAxis;
             }
             State::LoadAxis => {
-                self.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
-                if old.a_q == self.axes - 1 {
-                    self.out.start = true;
-                    self.state = State::Wait;
+                r.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
+                if old.a_q == axes - 1 {
+                    out.start = true;
+                    r.state = State::Wait;
                 } else {
-                    self.out.load_axis = true;
+                    out.load_axis = true;
                 }
             }
             State::Wait => {
                 if i.done {
-                    self.fresh = true;
-                    self.state = State::Idle;
+                    r.fresh = true;
+                    r.state = State::Idle;
                 }
             }
         }
         if i.tick && old.state != State::Idle {
-            self.out.late = true;
+            out.late = true;
         }
     }
 
     /// The outputs that are registers or memory reads as they stand.
     fn publish(&mut self) {
-        let o = &mut self.out;
-        let sh = self.shape_q;
+        let (o, r) = (&mut self.out, &self.reg);
+        let sh = r.shape_q;
         o.arc = sh.arc;
         o.ccw = sh.ccw;
         o.plane_first = sh.plane_first;
@@ -444,12 +465,12 @@ impl PathSequencer {
         o.growth = sh.growth;
         o.start_angle = sh.start_angle;
         o.rate = sh.rate;
-        o.axis = self.a_q;
-        o.from = self.axis_q.0;
-        o.share = self.axis_q.1;
-        o.segment = self.k;
-        o.running = self.state != State::Idle;
-        o.empty = self.last.wrapping_add(1) == self.oldest;
+        o.axis = r.a_q;
+        o.from = r.axis_q.0;
+        o.share = r.axis_q.1;
+        o.segment = r.k;
+        o.running = r.state != State::Idle;
+        o.empty = r.last.wrapping_add(1) == r.oldest;
     }
 }
 
@@ -654,7 +675,7 @@ mod tests {
         // The ring is full: segment 64 would take segment 0's slot, the current one.
         b.append(PATH_SLOTS as u16, 64 << 20, &g(64));
         assert!(b.seq.outputs().refused);
-        assert_eq!(b.seq.last, PATH_SLOTS as u16 - 1);
+        assert_eq!(b.seq.reg.last, PATH_SLOTS as u16 - 1);
         // Once the path has moved on, it is taken, and segment 0 is forgotten.
         let mut b = Bench::new(1);
         for k in 0..PATH_SLOTS as u16 {
@@ -662,11 +683,14 @@ mod tests {
         }
         b.tick(3 << 20, worst_clocks(1, 4));
         b.tick(3 << 20, worst_clocks(1, 4));
-        assert_eq!(b.seq.k, 3);
+        assert_eq!(b.seq.reg.k, 3);
         b.append(PATH_SLOTS as u16, 64 << 20, &g(64));
         let o = b.seq.outputs();
         assert!(!o.refused && !o.late, "{o:?}");
-        assert_eq!((b.seq.oldest, b.seq.last, b.seq.whole), (1, 64, false));
+        assert_eq!(
+            (b.seq.reg.oldest, b.seq.reg.last, b.seq.reg.whole),
+            (1, 64, false)
+        );
         // Rewriting a segment of the path, or an axis the design lacks: refused.
         let mut c = Bench::new(1);
         c.append(0, 0, &g(0));

@@ -1,0 +1,233 @@
+// The path sequencer (its reference, register for register, is
+// snapgen_model::path::sequencer): the ring of path segments the host writes ahead of the
+// motion and, on each tick, the segment the path length s lies in, the interpolator's load
+// and its start.
+//
+//   * The ring: PATH_SLOTS segments in block RAM (span, shape, one word per axis), wrapping
+//     PATH_INDEX_BITS-bit indices. A write is accepted after the path's last segment and less
+//     than PATH_SLOTS ahead of the current one (never over the current segment or one after
+//     it) and forgets the segment whose slot it takes; an extension ahead of the last and
+//     within the ring. Anything else sets the sticky `refused`.
+//   * A tick, when idle: `commit` if a computation ended since the last one, then (unless the
+//     path is empty) the seek. Each step reads the span, forms r = s - start and r - length
+//     (112-bit differences over two clocks each, split at SPLIT, for routed timing) and moves
+//     back a segment when r < 0 or on when r >= length, within oldest..last. Where it stops it
+//     clamps r (a cell before the path's first segment, a cell beyond its last, elsewhere the
+//     segment), loads the interpolator if it holds another segment (the shape, then one axis
+//     per clock), starts it and waits for `done`. A tick while this runs is `late` (sticky)
+//     and dropped.
+//
+// Template: snapgen_hdl fills the values in double braces (the axes, and whether seg_axis
+// names one: always, in a design of 8) and puts the widths it
+// names (X_BITS, PATH_SLOTS, ...) in front as localparams.
+
+localparam [3:0] S_IDLE = 4'd0, S_READ = 4'd1, S_OFFSET_LOW = 4'd2, S_OFFSET_HIGH = 4'd3,
+                 S_PAST_LOW = 4'd4, S_PAST_HIGH = 4'd5, S_DECIDE = 4'd6, S_LOAD_SHAPE = 4'd7,
+                 S_LOAD_AXIS = 4'd8, S_WAIT = 4'd9;
+localparam [AXIS_BITS-1:0] AXES_TOP = {{AXIS_BITS}}'d{{AXES_TOP}};   // the design's last axis
+localparam SHAPE_BITS = 2 + 2 * AXIS_BITS + 3 * X_BITS + SHARE_BITS + TURN_BITS + RATE_BITS;
+localparam AXIS_WORD_BITS = X_BITS + SHARE_BITS;
+localparam HIGH_BITS = X_BITS - SPLIT;            // the high half of a split difference
+localparam CELL_BITS = X_BITS - FRAC_BITS;        // whole cells of a position
+localparam [PATH_INDEX_BITS-1:0] RING = PATH_SLOTS[PATH_INDEX_BITS-1:0];
+localparam [PATH_INDEX_BITS-1:0] ONE_INDEX = 1;
+localparam [AXIS_BITS-1:0] ONE_AXIS = 1;
+localparam [CELL_BITS-1:0] ONE_CELL = 1;
+localparam [X_BITS-1:0] CELL = {{(CELL_BITS-1){1'b0}}, 1'b1, {FRAC_BITS{1'b0}}};
+localparam [X_BITS-1:0] MINUS_CELL = {{CELL_BITS{1'b1}}, {FRAC_BITS{1'b0}}};
+
+// ---- The ring -----------------------------------------------------------------------------
+(* ram_style = "block" *) reg [2*X_BITS-1:0] span_mem [0:PATH_SLOTS-1];       // {start, length}
+(* ram_style = "block" *) reg [SHAPE_BITS-1:0] shape_mem [0:PATH_SLOTS-1];
+(* ram_style = "block" *) reg [AXIS_WORD_BITS-1:0] axis_mem [0:PATH_SLOTS*8-1]; // {from, share} at {slot, axis}
+integer mem_i;
+initial begin
+   for (mem_i = 0; mem_i < PATH_SLOTS; mem_i = mem_i + 1) begin
+      span_mem[mem_i] = {2*X_BITS{1'b0}};
+      shape_mem[mem_i] = {SHAPE_BITS{1'b0}};
+   end
+   for (mem_i = 0; mem_i < PATH_SLOTS*8; mem_i = mem_i + 1) axis_mem[mem_i] = {AXIS_WORD_BITS{1'b0}};
+end
+
+reg [PATH_INDEX_BITS-1:0] k = {PATH_INDEX_BITS{1'b0}};        // the current segment
+reg [PATH_INDEX_BITS-1:0] oldest = {PATH_INDEX_BITS{1'b0}};   // the oldest still in the ring
+reg [PATH_INDEX_BITS-1:0] last = {PATH_INDEX_BITS{1'b1}};     // the path's last (oldest - 1: empty)
+reg whole = 1'b1;                                              // none forgotten since reset
+reg [PATH_INDEX_BITS-1:0] loaded = {PATH_INDEX_BITS{1'b0}};   // the segment the interpolator holds
+reg loaded_valid = 1'b0;
+
+// Registered reads of the current segment (the value before a write on the same clock).
+reg [2*X_BITS-1:0] span_q = {2*X_BITS{1'b0}};
+reg [SHAPE_BITS-1:0] shape_q = {SHAPE_BITS{1'b0}};
+reg [AXIS_WORD_BITS-1:0] axis_q = {AXIS_WORD_BITS{1'b0}};
+reg [AXIS_BITS-1:0] a_read = {AXIS_BITS{1'b0}};                // the axis read next
+reg [AXIS_BITS-1:0] a_q = {AXIS_BITS{1'b0}};                   // the axis of axis_q
+wire [PATH_SLOT_BITS-1:0] slot = k[PATH_SLOT_BITS-1:0];
+wire [PATH_SLOT_BITS-1:0] write_slot = seg_index[PATH_SLOT_BITS-1:0];
+wire [X_BITS-1:0] span_start = span_q[2*X_BITS-1:X_BITS];
+wire [X_BITS-1:0] span_length = span_q[X_BITS-1:0];
+
+// ---- The host's side: writes and extensions -----------------------------------------------
+wire [PATH_INDEX_BITS-1:0] after_last = seg_index - last;
+wire [PATH_INDEX_BITS-1:0] after_current = seg_index - k;
+wire [PATH_INDEX_BITS-1:0] after_oldest = seg_index - oldest;
+wire forward = (after_last != {PATH_INDEX_BITS{1'b0}}) && !after_last[PATH_INDEX_BITS-1];
+wire any_write = write_span || write_shape || write_axis;
+wire axis_exists = {{AXIS_EXISTS}};                // seg_axis is an axis of the design
+wire write_ok = forward && (after_current < RING) && (!write_axis || axis_exists);
+wire extend_ok = forward && (after_oldest < RING);
+wire is_empty = (last + ONE_INDEX) == oldest;
+
+always @(posedge clock) begin
+   span_q <= span_mem[slot];
+   shape_q <= shape_mem[slot];
+   axis_q <= axis_mem[{slot, a_read}];
+   a_q <= a_read;
+   if (!reset && any_write && write_ok) begin
+      if (write_span) span_mem[write_slot] <= {seg_start, seg_length};
+      if (write_shape) shape_mem[write_slot] <= {seg_arc, seg_ccw, seg_plane_first, seg_plane_second,
+                                                 seg_centre_first, seg_centre_second, seg_radius,
+                                                 seg_growth, seg_start_angle, seg_rate};
+      if (write_axis) axis_mem[{write_slot, seg_axis}] <= {seg_from, seg_share};
+   end
+end
+
+// ---- The seek -----------------------------------------------------------------------------
+reg [3:0] state = S_IDLE;
+reg fresh = 1'b0;                                 // a computation ended since the last commit
+reg [X_BITS-1:0] s_q = {X_BITS{1'b0}};            // the path length latched at the tick
+reg [X_BITS-1:0] r = {X_BITS{1'b0}};              // s - start
+reg [X_BITS-1:0] past = {X_BITS{1'b0}};           // r - length
+reg [SPLIT-1:0] low = {SPLIT{1'b0}};              // a difference's low half
+reg borrow = 1'b0;                                // and its borrow
+reg load_shape_q = 1'b0, load_axis_q = 1'b0, start_q = 1'b0, commit_q = 1'b0;
+reg late_q = 1'b0, refused_q = 1'b0;
+reg [X_BITS-1:0] offset_q = {X_BITS{1'b0}};
+
+wire [HIGH_BITS-1:0] borrow_in = {{(HIGH_BITS-1){1'b0}}, borrow};
+wire below = r[X_BITS-1];                          // r < 0
+wire beyond = !past[X_BITS-1];                     // r >= length
+wire at_oldest = k == oldest;
+wire at_last = k == last;
+wire first = at_oldest && whole;                   // the path's first segment
+wire [CELL_BITS-1:0] r_cells = r[X_BITS-1:FRAC_BITS];
+wire [CELL_BITS-1:0] past_cells = past[X_BITS-1:FRAC_BITS];
+// Below a cell before the path's first segment, or below the start of any other.
+wire under = first ? ($signed(r_cells) < -$signed(ONE_CELL)) : below;
+// More than a cell beyond the last segment's end.
+wire over = at_last && ($signed(past_cells) >= $signed(ONE_CELL)) && (past != CELL);
+wire [X_BITS-1:0] length_and_cell = {span_length[X_BITS-1:FRAC_BITS] + ONE_CELL,
+                                     span_length[FRAC_BITS-1:0]};
+
+always @(posedge clock) begin
+   load_shape_q <= 1'b0;
+   load_axis_q <= 1'b0;
+   start_q <= 1'b0;
+   commit_q <= 1'b0;
+   if (reset) begin
+      state <= S_IDLE;
+      k <= {PATH_INDEX_BITS{1'b0}};
+      oldest <= {PATH_INDEX_BITS{1'b0}};
+      last <= {PATH_INDEX_BITS{1'b1}};
+      whole <= 1'b1;
+      loaded_valid <= 1'b0;
+      fresh <= 1'b0;
+      late_q <= 1'b0;
+      refused_q <= 1'b0;
+   end else begin
+      // The host's side.
+      if (any_write && write_ok && !(after_oldest < RING)) begin
+         oldest <= seg_index - (RING - ONE_INDEX);   // the slot's segment is forgotten
+         whole <= 1'b0;
+      end
+      if ((any_write && !write_ok) || (extend && !extend_ok)) refused_q <= 1'b1;
+      if (extend && extend_ok) last <= seg_index;
+      if (tick && state != S_IDLE) late_q <= 1'b1;
+      case (state)
+      S_IDLE: if (tick) begin
+         if (fresh) begin
+            commit_q <= 1'b1;
+            fresh <= 1'b0;
+         end
+         if (!is_empty) begin
+            s_q <= s;
+            state <= S_READ;
+         end
+      end
+      S_READ: state <= S_OFFSET_LOW;
+      S_OFFSET_LOW: begin
+         {borrow, low} <= {1'b0, s_q[SPLIT-1:0]} - {1'b0, span_start[SPLIT-1:0]};
+         state <= S_OFFSET_HIGH;
+      end
+      S_OFFSET_HIGH: begin
+         r <= {s_q[X_BITS-1:SPLIT] - span_start[X_BITS-1:SPLIT] - borrow_in, low};
+         state <= S_PAST_LOW;
+      end
+      S_PAST_LOW: begin
+         {borrow, low} <= {1'b0, r[SPLIT-1:0]} - {1'b0, span_length[SPLIT-1:0]};
+         state <= S_PAST_HIGH;
+      end
+      S_PAST_HIGH: begin
+         past <= {r[X_BITS-1:SPLIT] - span_length[X_BITS-1:SPLIT] - borrow_in, low};
+         state <= S_DECIDE;
+      end
+      S_DECIDE: if (below && !at_oldest) begin
+         k <= k - ONE_INDEX;
+         state <= S_READ;
+      end else if (beyond && !at_last) begin
+         k <= k + ONE_INDEX;
+         state <= S_READ;
+      end else begin
+         if (under) offset_q <= first ? MINUS_CELL : {X_BITS{1'b0}};
+         else if (over) offset_q <= length_and_cell;
+         else offset_q <= r;
+         a_read <= {AXIS_BITS{1'b0}};
+         if (loaded_valid && loaded == k) begin
+            start_q <= 1'b1;
+            state <= S_WAIT;
+         end else begin
+            load_shape_q <= 1'b1;
+            loaded_valid <= 1'b1;
+            loaded <= k;
+            state <= S_LOAD_SHAPE;
+         end
+      end
+      S_LOAD_SHAPE: begin
+         a_read <= a_read + ONE_AXIS;
+         load_axis_q <= 1'b1;
+         state <= S_LOAD_AXIS;
+      end
+      S_LOAD_AXIS: begin
+         a_read <= a_read + ONE_AXIS;
+         if (a_q == AXES_TOP) begin
+            start_q <= 1'b1;
+            state <= S_WAIT;
+         end else begin
+            load_axis_q <= 1'b1;
+         end
+      end
+      S_WAIT: if (done) begin
+         fresh <= 1'b1;
+         state <= S_IDLE;
+      end
+      default: state <= S_IDLE;
+      endcase
+   end
+end
+
+always @(*) begin
+   load_shape = load_shape_q;
+   {arc, ccw, plane_first, plane_second, centre_first, centre_second, radius, growth,
+    start_angle, rate} = shape_q;
+   load_axis = load_axis_q;
+   axis = a_q;
+   {from, share} = axis_q;
+   start = start_q;
+   offset = offset_q;
+   commit = commit_q;
+   segment = k;
+   running = state != S_IDLE;
+   empty = is_empty;
+   late = late_q;
+   refused = refused_q;
+end

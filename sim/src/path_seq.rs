@@ -1,0 +1,492 @@
+//! The Verilated path sequencer (`snapgen_path_sequencer`) in lockstep with its model
+//! (`snapgen_model::path::sequencer::PathSequencer`): every output compared on every clock,
+//! and the positions its commits publish checked against the rule, [`Path::at`].
+//!
+//! The stream, run after run (each begins with a reset): a path of 1 to 200 segments from the
+//! host's planner (random paths of [`crate::interp`]'s kind, end to end, so the ring of
+//! `PATH_SLOTS` wraps and forgets), written word by word with random gaps as the ring makes
+//! room ahead of the current segment and extended a few segments at a time; ticks every
+//! `worst_clocks` to 2000 clocks more, now and then one too soon (`late`); the path length at
+//! each tick moving on by a random fraction of a segment, staying, jumping several segments,
+//! stepping back within a cell or back across a segment start, and running a few cells past
+//! the end of the path written so far. Once per run in a fifth of the runs, a write or an
+//! extension that must be refused (a segment of the path rewritten, one too far ahead, an
+//! axis the design lacks, an extension past the ring); the other runs must never raise
+//! `refused`.
+//!
+//! The interpolator beside it is its model (`snapgen_model::path::engine::Engine`, itself
+//! checked against its fabric in [`crate::interp`]), driven by the sequencer's outputs; the
+//! axes' registers take its writes and the commits. At each commit the positions must equal
+//! `Path::at(s)` for the `s` of the computation committed, on the path as it was extended
+//! when that computation began (a computation during which the path was extended is not
+//! checked: its last segment is ambiguous). So the model's seek and clamps are checked by a
+//! second implementation, not by themselves.
+
+use std::path::Path as FsPath;
+
+use rand::{Rng, SeedableRng};
+use snapgen_model::path::engine::{load_inputs, Engine};
+use snapgen_model::path::interp::{Path, Segment};
+use snapgen_model::path::sequencer::{worst_clocks, PathSequencer};
+use snapgen_model::{InterpInputs, PathSeqInputs, PathSeqOutputs, FRAC_BITS};
+use snapgen_spec::widths::{MAX_AXES, PATH_SLOTS};
+
+use crate::interp::random_path;
+use crate::layout::{first_difference, harness_header, port_layout};
+pub use crate::layout::{PortFault, PortMismatch};
+use crate::verilated::{abi, Verilated};
+use crate::SimError;
+
+snapgen_spec::with_path_sequencer_ports!(port_layout! {
+    PATH_SEQ_INPUTS, PATH_SEQ_OUTPUTS, PathSeqInputs, PathSeqOutputs;
+});
+
+/// The sequencer's tag in the harness's ABI word.
+const PATH_SEQ_TAG: u32 = 5;
+
+/// Clocks the model runs before the fabric runs them in one call.
+const BATCH: usize = 65_536;
+
+/// The harness's generated header (`snapgen_layout.h`): every input at rest is 0.
+pub fn path_seq_layout_header() -> String {
+    harness_header(
+        &PATH_SEQ_INPUTS,
+        &PATH_SEQ_OUTPUTS,
+        abi(PATH_SEQ_TAG, IN_WORDS, OUT_WORDS),
+        &encode_inputs(&PathSeqInputs::default()),
+    )
+}
+
+/// A run's settings.
+#[derive(Clone, Debug)]
+pub struct PathSeqConfig {
+    /// Axes of the design (1 to 8).
+    pub axes: u8,
+    /// Clocks to run.
+    pub clocks: u64,
+    /// Seed of the stream.
+    pub seed: u64,
+    /// Test hook: flip a bit of an output of the fabric's (`port` indexes
+    /// [`PATH_SEQ_OUTPUTS`]).
+    pub fault: Option<PortFault>,
+}
+
+/// What a run did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PathSeqReport {
+    /// Clocks compared.
+    pub clocks: u64,
+    /// Runs (paths) played.
+    pub runs: u64,
+    /// Segments written (every word) and extended.
+    pub segments: u64,
+    /// Runs whose ring wrapped (a segment forgotten).
+    pub wrapped: u64,
+    /// Ticks given.
+    pub ticks: u64,
+    /// Ticks given too soon on purpose, and runs that raised `late`.
+    pub early: u64,
+    /// See [`PathSeqReport::early`].
+    pub late_runs: u64,
+    /// Seek steps back and on (moves of the current segment).
+    pub moves: u64,
+    /// Commits.
+    pub commits: u64,
+    /// Commits checked against the rule.
+    pub checked: u64,
+    /// Of those, the first that differed (must be None).
+    pub rule_error: Option<String>,
+    /// Writes or extensions that must be refused, and of those how many were.
+    pub probes: u64,
+    /// See [`PathSeqReport::probes`].
+    pub refused: u64,
+    /// Runs without a probe that raised `refused` (must be 0).
+    pub false_refusals: u64,
+    /// The first difference between fabric and model, if any.
+    pub mismatch: Option<PortMismatch>,
+}
+
+/// A path of `segments` or so segments, end to end from random planner paths (their
+/// positions jump where two meet: the sequencer does not care, the rule neither).
+fn long_path(rng: &mut impl Rng, axes: u8, segments: usize) -> Path {
+    let mut all = Vec::new();
+    while all.len() < segments {
+        if let Some(p) = random_path(rng, usize::from(axes)) {
+            let fits = p.segments.iter().all(|g| load_inputs(g, axes).is_ok());
+            if fits {
+                all.extend(p.segments);
+            }
+        }
+    }
+    all.truncate(segments);
+    Path { segments: all }
+}
+
+/// The host: the path, what it has written and extended, and the words queued.
+struct Host {
+    path: Path,
+    starts: Vec<i128>,
+    /// Segments extended (the path's last is `extended − 1`).
+    extended: usize,
+    /// Segments written (every word).
+    written: usize,
+    /// Words of the segment being written.
+    queue: std::collections::VecDeque<PathSeqInputs>,
+    /// The probe of this run: at which tick.
+    probe_at: Option<u64>,
+    /// The run has ended: clocks left before the next run's reset (the last tick's commit
+    /// is still checked).
+    ending: Option<u32>,
+}
+
+/// The computation running or last ended: its `s`, the path's length in segments when it
+/// began, and whether the path was extended while it ran.
+#[derive(Clone, Copy, Debug, Default)]
+struct Computation {
+    s: i128,
+    extended: usize,
+    changed: bool,
+}
+
+/// The words that write segment `index` of `g` for `axes` axes (span and shape together or
+/// apart, then each axis).
+fn segment_words(
+    rng: &mut impl Rng,
+    index: u16,
+    start: i128,
+    g: &Segment,
+    axes: u8,
+) -> Vec<PathSeqInputs> {
+    let words = load_inputs(g, axes).expect("checked when the path was made");
+    let sh: &InterpInputs = &words[0];
+    let span = PathSeqInputs {
+        seg_index: index,
+        write_span: true,
+        seg_start: start,
+        seg_length: g.length,
+        ..Default::default()
+    };
+    let shape = PathSeqInputs {
+        seg_index: index,
+        write_shape: true,
+        seg_arc: sh.arc,
+        seg_ccw: sh.ccw,
+        seg_plane_first: sh.plane_first,
+        seg_plane_second: sh.plane_second,
+        seg_centre_first: sh.centre_first,
+        seg_centre_second: sh.centre_second,
+        seg_radius: sh.radius,
+        seg_growth: sh.growth,
+        seg_start_angle: sh.start_angle,
+        seg_rate: sh.rate,
+        ..Default::default()
+    };
+    let mut out = if rng.gen_bool(0.5) {
+        vec![PathSeqInputs {
+            write_span: true,
+            seg_start: start,
+            seg_length: g.length,
+            ..shape
+        }]
+    } else {
+        vec![shape, span]
+    };
+    for w in &words[1..] {
+        out.push(PathSeqInputs {
+            seg_index: index,
+            write_axis: true,
+            seg_axis: w.axis,
+            seg_from: w.from,
+            seg_share: w.share,
+            ..Default::default()
+        });
+    }
+    out
+}
+
+/// A write or extension that the sequencer must refuse, given its registers.
+fn probe(rng: &mut impl Rng, seq: &PathSequencer, axes: u8) -> PathSeqInputs {
+    let r = seq.reg;
+    let ring = PATH_SLOTS as u16;
+    match rng.gen_range(0..4) {
+        // A segment of the path (the current one) rewritten.
+        0 => PathSeqInputs {
+            seg_index: r.k,
+            write_span: true,
+            ..Default::default()
+        },
+        // A segment a whole ring ahead of the current one.
+        1 => PathSeqInputs {
+            seg_index: r.k.wrapping_add(ring + rng.gen_range(0..100)),
+            write_shape: true,
+            ..Default::default()
+        },
+        // An axis the design lacks (or, with every axis, an extension backwards).
+        2 if axes < MAX_AXES as u8 => PathSeqInputs {
+            seg_index: r.last.wrapping_add(1),
+            write_axis: true,
+            seg_axis: rng.gen_range(axes..MAX_AXES as u8),
+            ..Default::default()
+        },
+        2 => PathSeqInputs {
+            seg_index: r.last.wrapping_sub(1),
+            extend: true,
+            ..Default::default()
+        },
+        // An extension past the ring.
+        _ => PathSeqInputs {
+            seg_index: r.oldest.wrapping_add(ring + rng.gen_range(0..100)),
+            extend: true,
+            ..Default::default()
+        },
+    }
+}
+
+/// Runs the stream of `cfg` on the library `library` (built by
+/// [`crate::build::build_path_sequencer`] for `cfg.axes` axes).
+pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimError> {
+    let axes = cfg.axes;
+    let mut fabric = Verilated::open(library, None, PATH_SEQ_TAG, IN_WORDS, OUT_WORDS)?;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(cfg.seed);
+    let mut seq = PathSequencer::new(axes).map_err(|e| SimError::Config(e.to_string()))?;
+    let mut engine = Engine::new(axes);
+    let mut r = PathSeqReport::default();
+    let cell = 1i128 << FRAC_BITS;
+    let shortest = worst_clocks(axes, 1);
+    let (mut ins, mut want, mut got) = (Vec::new(), Vec::new(), Vec::new());
+    let mut next_pos = vec![0i128; usize::from(axes)];
+    let mut batch_start = 0u64;
+    // The stream's state, run by run.
+    let mut host: Option<Host> = None;
+    let (mut s, mut until_tick, mut period, mut run_ticks) = (0i128, 0u64, shortest, 0u64);
+    let (mut running, mut ended): (Option<Computation>, Option<Computation>) = (None, None);
+    let (mut probed, mut probe_given) = (false, false);
+    // The path length never goes below `s_low`, the start of the segment before the one it
+    // was in (`k_low`): so a seek never ends below `k_low`, and the sequencer's segment never
+    // goes below the lower of `k_low` and where it is (a tick dropped or a seek running leaves
+    // it behind); the host writes less than a ring ahead of that.
+    let (mut s_low, mut k_low) = (i128::MIN, 0usize);
+    while r.clocks < cfg.clocks {
+        let o = seq.outputs();
+        let e = engine.outputs();
+        let mut i = PathSeqInputs {
+            done: e.done,
+            s,
+            ..Default::default()
+        };
+        if e.out_write {
+            next_pos[usize::from(e.out_axis)] = e.out_value;
+        }
+        if std::mem::take(&mut probe_given) {
+            r.refused += u64::from(o.refused);
+        }
+        if o.commit {
+            r.commits += 1;
+            let h = host.as_ref().expect("a run");
+            let c = ended.take();
+            if c.is_none() && r.rule_error.is_none() {
+                r.rule_error = Some(format!("clock {}: a commit with no computation", r.clocks));
+            }
+            if let Some(c) = c.filter(|c| !c.changed) {
+                let prefix = Path {
+                    segments: h.path.segments[..c.extended].to_vec(),
+                };
+                let expect = prefix.at(c.s).expect("a segment");
+                r.checked += 1;
+                if expect != next_pos && r.rule_error.is_none() {
+                    r.rule_error = Some(format!(
+                        "clock {}: s = {} on {} segments: committed {next_pos:?}, the rule says {expect:?}",
+                        r.clocks, c.s, c.extended
+                    ));
+                }
+            }
+        }
+        if e.done {
+            ended = running.take();
+        }
+        if let Some(h) = host.as_mut() {
+            if let Some(left) = h.ending.as_mut() {
+                *left = left.saturating_sub(1);
+                if *left == 0 {
+                    host = None;
+                }
+            }
+        }
+        match host.as_mut() {
+            Some(h) if h.ending.is_some() => {}
+            None => {
+                // A new run: reset, and a new path.
+                i.reset = true;
+                let n = if rng.gen_bool(0.3) {
+                    rng.gen_range(1..=8)
+                } else {
+                    rng.gen_range(9..=200)
+                };
+                let path = long_path(&mut rng, axes, n);
+                let mut starts = Vec::with_capacity(n);
+                let mut at = 0i128;
+                for g in &path.segments {
+                    starts.push(at);
+                    at += g.length;
+                }
+                s = rng.gen_range(-cell..cell / 2);
+                i.s = s;
+                period = shortest + rng.gen_range(0..2_000);
+                until_tick = period;
+                run_ticks = 0;
+                running = None;
+                ended = None;
+                probed = false;
+                (s_low, k_low) = (-cell - cell / 2, 0);
+                host = Some(Host {
+                    path,
+                    starts,
+                    extended: 0,
+                    written: 0,
+                    queue: Default::default(),
+                    probe_at: rng.gen_bool(0.2).then(|| rng.gen_range(1..30)),
+                    ending: None,
+                });
+                r.runs += 1;
+                for p in &mut next_pos {
+                    *p = 0;
+                }
+            }
+            Some(h) => {
+                let n = h.path.segments.len();
+                // The host's writes: as the ring makes room ahead of the current segment.
+                if let Some(w) = h.queue.pop_front() {
+                    i = PathSeqInputs {
+                        done: i.done,
+                        s,
+                        ..w
+                    };
+                    if h.queue.is_empty() {
+                        h.written += 1;
+                        r.segments += 1;
+                    }
+                } else if h.probe_at == Some(run_ticks) && !probed && rng.gen_bool(0.01) {
+                    i = PathSeqInputs {
+                        done: i.done,
+                        s,
+                        ..probe(&mut rng, &seq, axes)
+                    };
+                    // Refused on this clock (a false refusal before it would hide it).
+                    r.false_refusals += u64::from(o.refused);
+                    probed = true;
+                    probe_given = true;
+                    r.probes += 1;
+                } else if h.written < n
+                    && h.written < lowest(k_low, o.segment) + PATH_SLOTS as usize
+                    && rng.gen_bool(0.3)
+                {
+                    let k = h.written;
+                    h.queue =
+                        segment_words(&mut rng, k as u16, h.starts[k], &h.path.segments[k], axes)
+                            .into();
+                } else if h.extended < h.written
+                    && (h.written - h.extended >= rng.gen_range(1..=4) || h.written == n)
+                    && rng.gen_bool(0.2)
+                {
+                    i.seg_index = (h.written - 1) as u16;
+                    i.extend = true;
+                    h.extended = h.written;
+                    if let Some(c) = running.as_mut() {
+                        c.changed = true;
+                    }
+                }
+                // The ticks.
+                until_tick = until_tick.saturating_sub(1);
+                if until_tick == 0 && h.extended > 0 {
+                    let total: i128 =
+                        h.starts[h.extended - 1] + h.path.segments[h.extended - 1].length;
+                    let here = h.starts.partition_point(|&st| st <= s).max(1) - 1;
+                    let seg_len = h.path.segments[here].length.max(1);
+                    s += match rng.gen_range(0..100) {
+                        0..=64 => rng.gen_range(0..=seg_len / 8 + 1),
+                        65..=74 => 0,
+                        75..=84 => rng.gen_range(0..=(total / 4).max(1)),
+                        85..=89 => -rng.gen_range(0..cell),
+                        90..=94 => -rng.gen_range(0..=seg_len / 4 + 1),
+                        _ => rng.gen_range(0..4 * cell),
+                    };
+                    s = s.clamp(s_low, total + 3 * cell);
+                    let here = h.starts.partition_point(|&st| st <= s).max(1) - 1;
+                    if here.saturating_sub(1) > k_low {
+                        k_low = here - 1;
+                        s_low = h.starts[k_low];
+                    }
+                    i.tick = true;
+                    i.s = s;
+                    r.ticks += 1;
+                    run_ticks += 1;
+                    if o.running {
+                        // Dropped (late): the computation running goes on.
+                    } else {
+                        running = Some(Computation {
+                            s,
+                            extended: h.extended,
+                            changed: i.extend,
+                        });
+                    }
+                    let early = rng.gen_bool(0.02);
+                    r.early += u64::from(early);
+                    until_tick = if early {
+                        rng.gen_range(1..shortest)
+                    } else {
+                        period
+                    };
+                    // A run ends once its path is played and left behind.
+                    if h.extended == n && s >= total && rng.gen_bool(0.2) && h.queue.is_empty() {
+                        r.late_runs += u64::from(seq.outputs().late);
+                        if seq.reg.oldest != 0 || !seq.reg.whole {
+                            r.wrapped += 1;
+                        }
+                        if !probed && seq.outputs().refused {
+                            r.false_refusals += 1;
+                        }
+                        h.ending = Some(3);
+                    }
+                }
+            }
+        }
+        let k_before = seq.reg.k;
+        ins.extend_from_slice(&encode_inputs(&i));
+        seq.clock(&i);
+        engine.clock(&PathSequencer::interp_inputs(&o, i.reset));
+        r.moves += u64::from(seq.reg.k != k_before && !i.reset);
+        want.extend_from_slice(&encode_outputs(&seq.outputs()));
+        r.clocks += 1;
+        if want.len() >= BATCH * OUT_WORDS || r.clocks == cfg.clocks {
+            fabric.run_each(&ins, &mut got);
+            if let Some(f) = cfg.fault {
+                f.apply(&OUT_SLOTS, OUT_WORDS, batch_start, &mut got);
+            }
+            if got != want {
+                if let Some(m) = first_difference(
+                    &PATH_SEQ_OUTPUTS,
+                    &OUT_SLOTS,
+                    OUT_WORDS,
+                    batch_start,
+                    &got,
+                    &want,
+                ) {
+                    r.clocks = m.clock + 1;
+                    r.mismatch = Some(m);
+                    return Ok(r);
+                }
+            }
+            batch_start = r.clocks;
+            ins.clear();
+            want.clear();
+        }
+    }
+    Ok(r)
+}
+
+/// The lowest segment the sequencer may be on from now: the lower of `k_low` and its
+/// `segment` output (wrapping: the index nearest `k_low`).
+fn lowest(k_low: usize, segment: u16) -> usize {
+    let off = i64::from(segment.wrapping_sub(k_low as u16) as i16);
+    (k_low as i64 + off.min(0)).max(0) as usize
+}
