@@ -268,5 +268,6 @@ fn synth_keeps_the_motion_core_within_budget() {
     assert!(text.contains("| stop unit"), "{text}");
     assert!(text.contains("| board top"), "{text}");
     assert!(text.contains("| path interpolator for 4 axes"), "{text}");
+    assert!(text.contains("| path sequencer for 4 axes"), "{text}");
     assert!(text.contains("| step/dir generator of one axis"), "{text}");
 }

@@ -14,8 +14,9 @@
 //! for rust-hdl's simulator it runs the model's engine. The Verilog is what is checked:
 //! Verilator co-simulation against the engine on every clock (`snapgen_sim::interp`).
 //!
-//! The block is not yet part of a generated design: the path sequencer that loads segments
-//! and starts it on each tick, and the N-axis core around it, are still to be built.
+//! The path sequencer (`crate::path_sequencer`) loads its segments and starts it on each tick;
+//! neither is yet part of a generated design: the N-axis core around them is still to be
+//! built.
 
 use rust_hdl::prelude::*;
 use snapgen_model::path::cordic::{constants, ITERATIONS};

@@ -350,9 +350,7 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     ending: None,
                 });
                 r.runs += 1;
-                for p in &mut next_pos {
-                    *p = 0;
-                }
+                next_pos.fill(0);
             }
             Some(h) => {
                 let n = h.path.segments.len();

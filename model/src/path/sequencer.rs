@@ -682,6 +682,44 @@ mod tests {
     }
 
     #[test]
+    fn worst_clocks_bounds_a_tick_that_moves_on_a_segment_into_an_arc() {
+        // Arcs end to end; each tick one segment on, so each tick seeks a step, loads an arc
+        // and computes it: the busiest tick there is (a tick must not be shorter).
+        for axes in [2u8, 4, 8] {
+            let mut b = Bench::new(axes);
+            let arc = quarter_arc();
+            let g = |k: u16| {
+                let mut g = arc.clone();
+                if let Shape::Arc { from, dir, .. } = &mut g.shape {
+                    from.resize(usize::from(axes), i128::from(k));
+                    dir.resize(usize::from(axes), 0);
+                }
+                g
+            };
+            for k in 0..8u16 {
+                b.append(k, i128::from(k) << 100, &g(k));
+            }
+            let mut longest = 0;
+            for k in 0..8i128 {
+                b.inputs.tick = true;
+                b.inputs.s = (k << 100) + (1 << 99);
+                b.clock();
+                let mut n = 1;
+                while b.seq.outputs().running {
+                    b.clock();
+                    n += 1;
+                }
+                longest = longest.max(n);
+            }
+            let bound = worst_clocks(axes, 1);
+            assert!(
+                longest <= bound && longest + 4 >= bound,
+                "{axes}: {longest} vs {bound}"
+            );
+        }
+    }
+
+    #[test]
     fn a_tick_too_soon_is_late_and_dropped() {
         let mut b = Bench::new(2);
         let g = line(vec![0, 0], vec![ONE, ONE / 2], 1 << 90);
