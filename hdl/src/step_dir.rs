@@ -53,6 +53,7 @@ impl Logic for StepDirGenerator {
         self.dir.next = o.dir;
         self.steps.next = u64::from(o.steps).into();
         self.overrun.next = o.overrun;
+        self.due.next = o.due;
     }
 
     fn connect(&mut self) {
@@ -60,6 +61,7 @@ impl Logic for StepDirGenerator {
         self.dir.connect();
         self.steps.connect();
         self.overrun.connect();
+        self.due.connect();
     }
 
     fn hdl(&self) -> Verilog {

@@ -13,6 +13,8 @@
 //!   [`crate::io::step_dir`]) for one clock.
 //! * [`PathSeqInputs`], [`PathSeqOutputs`]: the path sequencer (`snapgen_path_sequencer`,
 //!   [`crate::path::sequencer`]) for one clock.
+//! * [`PathSteppersInputs`], [`PathSteppersOutputs`]: the path steppers
+//!   (`snapgen_path_steppers`, [`crate::path::steppers`]) for one clock.
 
 /// A block's inputs and outputs as two structs.
 macro_rules! port_structs {
@@ -48,6 +50,9 @@ snapgen_spec::with_step_dir_ports!(port_structs! {
 });
 snapgen_spec::with_path_sequencer_ports!(port_structs! {
     PathSeqInputs, PathSeqOutputs, "the path sequencer";
+});
+snapgen_spec::with_path_steppers_ports!(port_structs! {
+    PathSteppersInputs, PathSteppersOutputs, "the path steppers";
 });
 
 /// The core's `command` inputs and `status` outputs as structs of their own.

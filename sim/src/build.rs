@@ -188,6 +188,28 @@ pub fn build_path_sequencer_from(verilog: &str, trace: bool) -> Result<Built, Si
     )
 }
 
+/// Builds (or finds in the cache) the library of the path steppers for `axes` axes
+/// ([`crate::path_steppers`]: the stage's file and the three blocks' it instantiates).
+pub fn build_path_steppers(axes: u8, trace: bool) -> Result<Built, SimError> {
+    build_path_steppers_from(
+        &snapgen_hdl::path_steppers::path_steppers_sources_text(axes),
+        trace,
+    )
+}
+
+/// Builds the path steppers' library from the Verilog `verilog` (every source of the stage:
+/// the generator's, or a deliberately altered copy).
+pub fn build_path_steppers_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "path-steppers",
+        snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX,
+        verilog,
+        HARNESS_CPP,
+        &crate::path_steppers::path_steppers_layout_header(),
+        trace,
+    )
+}
+
 /// Builds (or finds in the cache) the library of the step/dir generator ([`crate::step_dir`]),
 /// with VCD tracing if `trace`.
 pub fn build_step_dir(trace: bool) -> Result<Built, SimError> {

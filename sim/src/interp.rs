@@ -85,15 +85,16 @@ pub struct InterpReport {
 }
 
 /// A random path of `axes` axes from the planner: 1 to 6 lines and arcs (helices when there
-/// are more than two axes) from a random start, within ±2^30 output LSBs.
-pub(crate) fn random_path(rng: &mut impl Rng, axes: usize) -> Option<Path> {
+/// are more than two axes) from a random start, within ±2^30 output LSBs, each element up to
+/// 10^`max_exponent` LSBs long or so.
+pub(crate) fn random_path(rng: &mut impl Rng, axes: usize, max_exponent: u32) -> Option<Path> {
     let mut at: Vec<i64> = (0..axes)
         .map(|_| rng.gen_range(-(1 << 30)..1 << 30))
         .collect();
     let start = at.clone();
     let mut elements = Vec::new();
     for _ in 0..rng.gen_range(1..=6) {
-        let scale = 10i64.pow(rng.gen_range(0..=8));
+        let scale = 10i64.pow(rng.gen_range(0..=max_exponent));
         let mut to: Vec<i64> = at
             .iter()
             .map(|&x| (x + rng.gen_range(-scale..=scale)).clamp(-(1 << 30), 1 << 30))
@@ -264,7 +265,7 @@ impl Stimulus {
                     return self.queue.pop_front().unwrap_or_default();
                 }
                 while self.segments.is_empty() {
-                    if let Some(p) = random_path(&mut self.rng, usize::from(self.axes)) {
+                    if let Some(p) = random_path(&mut self.rng, usize::from(self.axes), 8) {
                         self.segments = p.segments;
                         self.segments.reverse();
                     }
@@ -366,7 +367,9 @@ mod tests {
     fn the_planner_makes_paths_for_every_axis_count() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(3);
         for axes in 1..=8 {
-            let made = (0..20).filter_map(|_| random_path(&mut rng, axes)).count();
+            let made = (0..20)
+                .filter_map(|_| random_path(&mut rng, axes, 8))
+                .count();
             assert!(made >= 15, "{axes} axes: {made} of 20 paths prepared");
         }
     }

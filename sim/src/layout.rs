@@ -51,7 +51,7 @@ macro_rules! unsigned_port_value {
     )*};
 }
 
-unsigned_port_value!(u8, u16, u32, u64);
+unsigned_port_value!(u8, u16, u32, u64, u128);
 
 impl PortValue for i128 {
     #[inline(always)]

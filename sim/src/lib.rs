@@ -12,7 +12,8 @@
 //! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
 //!   model under random command streams; [`board`] is the virtual board on it.
 //! * [`interp`] runs the path interpolator in lockstep with its model, [`path_seq`] the path
-//!   sequencer, [`step_dir`] the step/dir generator (issue 22).
+//!   sequencer, [`step_dir`] the step/dir generator, [`path_steppers`] the N-axis stage made
+//!   of them (issue 22).
 
 pub mod board;
 pub mod build;
@@ -26,6 +27,7 @@ pub mod io_cosim;
 pub mod layout;
 pub mod moves;
 pub mod path_seq;
+pub mod path_steppers;
 pub mod step_dir;
 pub mod vcd;
 pub mod verilated;

@@ -110,10 +110,10 @@ pub struct PathSeqReport {
 
 /// A path of `segments` or so segments, end to end from random planner paths (their
 /// positions jump where two meet: the sequencer does not care, the rule neither).
-fn long_path(rng: &mut impl Rng, axes: u8, segments: usize) -> Path {
+fn long_path(rng: &mut impl Rng, axes: u8, segments: usize, max_exponent: u32) -> Path {
     let mut all = Vec::new();
     while all.len() < segments {
-        if let Some(p) = random_path(rng, usize::from(axes)) {
+        if let Some(p) = random_path(rng, usize::from(axes), max_exponent) {
             let fits = p.segments.iter().all(|g| load_inputs(g, axes).is_ok());
             if fits {
                 all.extend(p.segments);
@@ -152,7 +152,7 @@ struct Computation {
 
 /// The words that write segment `index` of `g` for `axes` axes (span and shape together or
 /// apart, then each axis).
-fn segment_words(
+pub(crate) fn segment_words(
     rng: &mut impl Rng,
     index: u16,
     start: i128,
@@ -324,7 +324,7 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                 } else {
                     rng.gen_range(9..=200)
                 };
-                let path = long_path(&mut rng, axes, n);
+                let path = long_path(&mut rng, axes, n, 8);
                 let mut starts = Vec::with_capacity(n);
                 let mut at = 0i128;
                 for g in &path.segments {

@@ -254,8 +254,8 @@ macro_rules! with_interpolator_ports {
 /// interpolator's inputs of the same names; its `done` input is the interpolator's `done`.
 #[macro_export]
 macro_rules! with_path_sequencer_ports {
-    ($callback:ident ! { $($extra:tt)* }) => {
-        $callback! { $($extra)*
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $($callback)::+ ! { $($extra)*
             clock: "Fabric clock.";
             inputs {
                 reset {
@@ -328,6 +328,71 @@ macro_rules! with_path_sequencer_ports {
     };
 }
 
+/// Calls `$callback! { $($extra)* <the path steppers' ports> }` (see the module
+/// documentation): the N-axis output stage of a path design for stepper drives: the path
+/// sequencer, the interpolator, each axis's position registers and a step/dir generator per
+/// axis (`snapgen_model::path::steppers`, issue 22). Its inputs are the sequencer's (but the
+/// interpolator's answer, which stays inside) and the drives' settings; its outputs the
+/// sequencer's status and the lines. Per-axis ports are vectors: axis `k` is bit `k` (or
+/// bits `16k..16k+15`).
+#[macro_export]
+macro_rules! with_path_steppers_ports {
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $crate::with_path_sequencer_ports! {
+            $crate::path_steppers_from_sequencer! { $($callback)::+ ! { $($extra)* } }
+        }
+    };
+}
+
+/// The path steppers' list from the path sequencer's (see [`with_path_steppers_ports!`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! path_steppers_from_sequencer {
+    (
+        $($callback:ident)::+ ! { $($extra:tt)* }
+        clock: $cdoc:literal;
+        inputs {
+            reset { $($reset:tt)* }
+            write { $($write:tt)* }
+            extend { $($extend:tt)* }
+            tick { $($tick:tt)* }
+            interpolator { $($answer:tt)* }
+        }
+        outputs {
+            interpolator { $($drive:tt)* }
+            axes { $($axes:tt)* }
+            status { $($status:tt)* }
+        }
+    ) => {
+        $($callback)::+ ! { $($extra)*
+            clock: $cdoc;
+            inputs {
+                reset { $($reset)* }
+                write { $($write)* }
+                extend { $($extend)* }
+                tick { $($tick)* }
+                drives {
+                    step_lsb: bits[$crate::widths::STEP_TIMER_BITS * $crate::widths::MAX_AXES] u128, "Each axis's output LSBs per step (axis k: bits 16k to 16k+15; 0 acts as 1).";
+                    high_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks a step line stays high (every axis; 0 acts as 1).";
+                    low_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks a step line stays low after a pulse (0 acts as 1).";
+                    setup_clocks: bits[$crate::widths::STEP_TIMER_BITS] u16, "Clocks a direction line is stable before a rising edge after it changes (0 acts as 1).";
+                    enable: bits[$crate::widths::MAX_AXES] u8, "Axis k's pulses follow its position (bit k); while low its step grid is anchored there.";
+                }
+            }
+            outputs {
+                status { $($status)* }
+                pins {
+                    step: bits[$crate::widths::MAX_AXES] u8, "Step lines (axis k: bit k; an axis the design lacks: 0).";
+                    dir: bits[$crate::widths::MAX_AXES] u8, "Direction lines (high: toward a larger position).";
+                }
+                drives {
+                    overrun: bits[$crate::widths::MAX_AXES] u8, "Axis k's pulses were behind when a tick's positions came (bit k: a step of the tick before was still due at the commit; sticky until disabled or reset): the axis moves faster than its pulses can follow.";
+                }
+            }
+        }
+    };
+}
+
 /// Calls `$callback! { $($extra)* <the step/dir generator's ports> }` (see the module
 /// documentation): one axis's stepper-drive output, made from its whole-LSB position
 /// (`snapgen_model::io::step_dir`, issue 22).
@@ -359,6 +424,7 @@ macro_rules! with_step_dir_ports {
                 status {
                     steps: bits[$crate::widths::POSITION_BITS] u32, "Steps issued since enabled, signed (wraps).";
                     overrun: bit[1] bool, "The position ran more than one step ahead of the pulses (sticky until disabled or reset): the axis moves faster than the pulse rate allows.";
+                    due: bit[1] bool, "On the last clock a step was due that had not begun (enabled, the position a step or more from the grid): the pulses are behind the position.";
                 }
             }
         }
@@ -392,6 +458,9 @@ with_interpolator_ports!(
 with_step_dir_ports!(block_table! { STEP_DIR, "the step/dir generator (`snapgen_step_dir`)"; });
 with_path_sequencer_ports!(
     block_table! { PATH_SEQUENCER, "the path sequencer (`snapgen_path_sequencer`)"; }
+);
+with_path_steppers_ports!(
+    block_table! { PATH_STEPPERS, "the path steppers (`snapgen_path_steppers`)"; }
 );
 
 /// What a board pin is wired to in the board top.
@@ -501,7 +570,14 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_sections_known() {
-        for b in [MOTION_CORE, IO_TOP, INTERPOLATOR, STEP_DIR, PATH_SEQUENCER] {
+        for b in [
+            MOTION_CORE,
+            IO_TOP,
+            INTERPOLATOR,
+            STEP_DIR,
+            PATH_SEQUENCER,
+            PATH_STEPPERS,
+        ] {
             let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
             names.push(b.clock);
             let n = names.len();

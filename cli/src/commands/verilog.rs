@@ -2,7 +2,9 @@
 //! which instantiates it) for a clock, baud rate and Ts; with `--interpolator AXES` also the
 //! path interpolator (`snapgen_interpolator.v`) and the path sequencer that drives it
 //! (`snapgen_path_sequencer.v`), with `--step-dir` the step/dir generator
-//! (`snapgen_step_dir.v`): issue 22's blocks of their own, not yet in the design.
+//! (`snapgen_step_dir.v`), with `--steppers AXES` the N-axis output stage for stepper drives
+//! that instantiates them (`snapgen_path_steppers.v` and the three blocks' files): issue 22's
+//! blocks, not yet in a board's design.
 
 use std::path::{Path, PathBuf};
 
@@ -25,6 +27,12 @@ pub struct Args {
     /// interpolator's inputs of the same names).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8))]
     interpolator: Option<u8>,
+    /// Also write the path steppers for this many axes (1 to 8), the N-axis output stage for
+    /// stepper drives, with the blocks it instantiates: `snapgen_path_steppers.v`,
+    /// `snapgen_path_sequencer.v`, `snapgen_interpolator.v`, `snapgen_step_dir.v` (not yet
+    /// in a board's design).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8), conflicts_with_all = ["interpolator", "step_dir"])]
+    steppers: Option<u8>,
     /// Also write the step/dir generator of one axis as `snapgen_step_dir.v` (a block of its
     /// own: no design instantiates it yet).
     #[arg(long)]
@@ -61,6 +69,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )
         .with_context(|| format!("cannot write {}", file.display()))?;
         println!("wrote {} ({axes} axes)", file.display());
+    }
+    if let Some(axes) = a.steppers {
+        for (name, text) in snapgen_hdl::path_steppers::path_steppers_sources(axes) {
+            let file = a.out.join(&name);
+            std::fs::write(&file, text)
+                .with_context(|| format!("cannot write {}", file.display()))?;
+            println!("wrote {} ({axes} axes)", file.display());
+        }
     }
     if a.step_dir {
         let file = a

@@ -19,7 +19,10 @@
 //! ahead of the pulses `overrun` is raised (sticky until disabled or reset). A reversal costs
 //! the setup time too: at most one step per `2 + high + low + setup` clocks
 //! ([`safe_steps_per_second`]) never raises it. Disabling lets
-//! a pulse that has begun finish, then anchors the grid again.
+//! a pulse that has begun finish, then anchors the grid again. `due` says, a clock late, that a
+//! step not yet begun was due (the pulses are behind the position): a stage that moves the
+//! position in jumps (the path steppers, once per tick) uses it to tell pulses that could not
+//! follow from a jump of several steps that they will.
 
 use crate::ports::{StepDirInputs, StepDirOutputs};
 
@@ -57,6 +60,8 @@ pub struct StepDir {
     pub steps: u32,
     /// The position ran more than a step ahead of the pulses.
     pub overrun: bool,
+    /// On the last clock a step was due that had not begun.
+    pub due: bool,
 }
 
 /// `x` with 0 taken as 1 (a length or a time of zero clocks would be none).
@@ -100,6 +105,7 @@ impl StepDir {
             dir: self.dir,
             steps: self.steps,
             overrun: self.overrun,
+            due: self.due,
         }
     }
 
@@ -119,6 +125,7 @@ impl StepDir {
         let ahead = |a: u32, b: u32| (a.wrapping_sub(b) as i32) >= 0;
         let want_up = ahead(i.position, old.up);
         let want_down = !ahead(i.position, old.down);
+        self.due = i.enable && (want_up || want_down);
         if !i.enable {
             self.overrun = false;
         } else if ahead(i.position, old.up.wrapping_add(k))

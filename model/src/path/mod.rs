@@ -3,11 +3,13 @@
 //!
 //! Built so far: [`interp`], the interpolator's rules for lines, arcs and helices,
 //! [`cordic`], the integer sine and cosine it uses, [`engine`], the fabric's interpolator
-//! clock by clock, and [`sequencer`], the fabric's ring of segments that finds the segment of
-//! each tick's path length and starts the interpolator on it. The group stop and the N-axis
-//! fabric around them are not built yet (issue 22).
+//! clock by clock, [`sequencer`], the fabric's ring of segments that finds the segment of
+//! each tick's path length and starts the interpolator on it, and [`steppers`], the N-axis
+//! output stage for stepper drives around both. The group stop and the N-axis fabric with the
+//! chain on `s` are not built yet (issue 22).
 
 pub mod cordic;
 pub mod engine;
 pub mod interp;
 pub mod sequencer;
+pub mod steppers;
