@@ -158,6 +158,7 @@ fn path_sequencer_body(axes: u8) -> String {
         ("PATH_INDEX_BITS", PATH_INDEX_BITS),
         ("PATH_SLOT_BITS", PATH_SLOT_BITS),
         ("PATH_SLOTS", PATH_SLOTS),
+        ("MAX_AXES", MAX_AXES),
         ("SPLIT", SPLIT),
     ]);
     crate::protocol_v::with_localparams(&params, &body)

@@ -137,10 +137,11 @@ fn path_steppers_body(axes: u8) -> String {
     assert!((1..=MAX_AXES as u8).contains(&axes), "1 to {MAX_AXES} axes");
     // The wires: between the sequencer and the interpolator (ip_*, named as the
     // interpolator's ports), the interpolator's other outputs, the sequencer's commit and status.
+    // (Its `busy` stays unconnected: the sequencer waits for `done`.)
     let mut wires: Vec<String> = INTERPOLATOR
         .ports
         .iter()
-        .filter(|p| p.name != "reset")
+        .filter(|p| p.name != "reset" && p.name != "busy")
         .map(|p| wire(&format!("ip_{}", p.name), p.bits))
         .collect();
     wires.extend(
@@ -167,10 +168,10 @@ fn path_steppers_body(axes: u8) -> String {
         "snapgen_interpolator",
         "interpolator",
         INTERPOLATOR.ports,
-        |p| {
-            if p.name == "reset" {
-                "reset".into()
-            } else {
+        |p| match p.name {
+            "reset" => "reset".into(),
+            "busy" => String::new(),
+            _ => {
                 debug_assert!(between(p) || p.dir == Dir::Out);
                 format!("ip_{}", p.name)
             }
@@ -191,10 +192,8 @@ fn path_steppers_body(axes: u8) -> String {
         "/* verilator lint_off PINCONNECTEMPTY */ // its steps count and own overrun are not used\n{drive}\n/* verilator lint_on PINCONNECTEMPTY */"
     );
     let interpolator = format!(
-        "/* verilator lint_off PINCONNECTEMPTY */ // busy: the sequencer waits for done\n{}\n/* verilator lint_on PINCONNECTEMPTY */",
-        interpolator.replace(".busy(ip_busy)", ".busy()")
+        "/* verilator lint_off PINCONNECTEMPTY */ // busy: the sequencer waits for done\n{interpolator}\n/* verilator lint_on PINCONNECTEMPTY */"
     );
-    wires.retain(|w| !w.ends_with(" ip_busy;"));
     let pad = |v: &str| {
         if u32::from(axes) == MAX_AXES {
             v.to_string()

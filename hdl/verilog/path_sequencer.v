@@ -4,27 +4,29 @@
 // and its start.
 //
 //   * The ring: PATH_SLOTS segments in block RAM (span, shape, one word per axis), wrapping
-//     PATH_INDEX_BITS-bit indices. A write is accepted after the path's last segment and less
-//     than PATH_SLOTS ahead of the current one (never over the current segment or one after
-//     it) and forgets the segment whose slot it takes; an extension ahead of the last and
-//     within the ring. Anything else sets the sticky `refused`.
+//     PATH_INDEX_BITS-bit indices. A write is accepted in order (the segment after the highest
+//     written, or more words of the highest while it is not in the path) into a free slot or
+//     one whose segment is more than one before the current (never the current segment or the
+//     one before it), and forgets the segment whose slot it takes; an extension takes in every
+//     segment written. Anything else sets the sticky `refused`.
 //   * A tick, when idle: `commit` if a computation ended since the last one, then (unless the
 //     path is empty) the seek. Each step reads the span (two clocks: every read passes the
 //     block RAM's register and one more, so its slow output drives only a register), forms
 //     r = s - start and r - length (112-bit differences over two clocks each, split at SPLIT,
-//     and their comparisons with a cell on a clock of their own, for routed timing) and moves back a segment when r < 0 or on when r >= length, within
-//     oldest..last. Where it stops it clamps r (a cell before the path's first segment, a
-//     cell beyond its last, elsewhere the segment), loads the interpolator if it holds
-//     another segment (the shape with axis 0, then one axis per clock), starts it and waits
-//     for `done`. A tick while this runs is `late` (sticky) and dropped.
+//     and their comparisons with a cell on a clock of their own, for routed timing) and
+//     moves back a segment when r < 0 or on when r >= length, within oldest..last and never
+//     both ways in one seek. Where it stops it clamps r (a cell before the path's first
+//     segment, a cell beyond its last, elsewhere the segment), loads the interpolator if it
+//     holds another segment (the shape with axis 0, then one axis per clock), starts it and
+//     waits for `done`. A tick while this runs is `late` (sticky) and dropped.
 //
 // Template: snapgen_hdl fills the values in double braces (the axes, and whether seg_axis
 // names one: always, in a design of 8) and puts the widths it names (X_BITS, PATH_SLOTS, ...)
 // in front as localparams.
 
-localparam [3:0] S_IDLE = 4'd0, S_READ = 4'd1, S_OFFSET_LOW = 4'd2, S_OFFSET_HIGH = 4'd3,
-                 S_PAST_LOW = 4'd4, S_PAST_HIGH = 4'd5, S_DECIDE = 4'd6, S_LOAD_AXIS = 4'd7,
-                 S_WAIT = 4'd8, S_FETCH = 4'd10, S_JUDGE = 4'd11;
+localparam [3:0] S_IDLE = 4'd0, S_READ = 4'd1, S_FETCH = 4'd2, S_OFFSET_LOW = 4'd3,
+                 S_OFFSET_HIGH = 4'd4, S_PAST_LOW = 4'd5, S_PAST_HIGH = 4'd6, S_JUDGE = 4'd7,
+                 S_DECIDE = 4'd8, S_LOAD_AXIS = 4'd9, S_WAIT = 4'd10;
 localparam [AXIS_BITS-1:0] AXES_TOP = {{AXIS_BITS}}'d{{AXES_TOP}};   // the design's last axis
 localparam SHAPE_BITS = 2 + 2 * AXIS_BITS + 3 * X_BITS + SHARE_BITS + TURN_BITS + RATE_BITS;
 localparam AXIS_WORD_BITS = X_BITS + SHARE_BITS;
@@ -40,19 +42,23 @@ localparam [X_BITS-1:0] MINUS_CELL = {{CELL_BITS{1'b1}}, {FRAC_BITS{1'b0}}};
 // ---- The ring -----------------------------------------------------------------------------
 (* ram_style = "block" *) reg [2*X_BITS-1:0] span_mem [0:PATH_SLOTS-1];       // {start, length}
 (* ram_style = "block" *) reg [SHAPE_BITS-1:0] shape_mem [0:PATH_SLOTS-1];
-(* ram_style = "block" *) reg [AXIS_WORD_BITS-1:0] axis_mem [0:PATH_SLOTS*8-1]; // {from, share} at {slot, axis}
+// {from, share} at {slot, axis}: MAX_AXES words per slot whatever the design's axes.
+(* ram_style = "block" *) reg [AXIS_WORD_BITS-1:0] axis_mem [0:PATH_SLOTS*MAX_AXES-1];
 integer mem_i;
 initial begin
    for (mem_i = 0; mem_i < PATH_SLOTS; mem_i = mem_i + 1) begin
       span_mem[mem_i] = {2*X_BITS{1'b0}};
       shape_mem[mem_i] = {SHAPE_BITS{1'b0}};
    end
-   for (mem_i = 0; mem_i < PATH_SLOTS*8; mem_i = mem_i + 1) axis_mem[mem_i] = {AXIS_WORD_BITS{1'b0}};
+   for (mem_i = 0; mem_i < PATH_SLOTS*MAX_AXES; mem_i = mem_i + 1)
+      axis_mem[mem_i] = {AXIS_WORD_BITS{1'b0}};
 end
 
 reg [PATH_INDEX_BITS-1:0] k = {PATH_INDEX_BITS{1'b0}};        // the current segment
 reg [PATH_INDEX_BITS-1:0] oldest = {PATH_INDEX_BITS{1'b0}};   // the oldest still in the ring
 reg [PATH_INDEX_BITS-1:0] last = {PATH_INDEX_BITS{1'b1}};     // the path's last (oldest - 1: empty)
+reg [PATH_INDEX_BITS-1:0] highest = {PATH_INDEX_BITS{1'b1}};      // the highest written since reset
+reg [PATH_INDEX_BITS-1:0] next_highest = {PATH_INDEX_BITS{1'b0}}; // highest + 1
 reg whole = 1'b1;                                              // none forgotten since reset
 reg [PATH_INDEX_BITS-1:0] loaded = {PATH_INDEX_BITS{1'b0}};   // the segment the interpolator holds
 reg loaded_valid = 1'b0;
@@ -72,15 +78,39 @@ wire [X_BITS-1:0] span_start = span_q[2*X_BITS-1:X_BITS];
 wire [X_BITS-1:0] span_length = span_q[X_BITS-1:0];
 
 // ---- The host's side: writes and extensions -----------------------------------------------
-wire [PATH_INDEX_BITS-1:0] after_last = seg_index - last;
-wire [PATH_INDEX_BITS-1:0] after_current = seg_index - k;
-wire [PATH_INDEX_BITS-1:0] after_oldest = seg_index - oldest;
-wire forward = (after_last != {PATH_INDEX_BITS{1'b0}}) && !after_last[PATH_INDEX_BITS-1];
+// A write: in order (to the segment after the highest written, or to the highest while it is
+// not yet in the path), and into a free slot or one whose segment is more than one before the
+// current (neither the current segment nor the one before it, where a seek may step back on
+// this very clock, is overwritten). An extension takes in every segment written: its index is
+// the highest written (on a clock after that segment's last write). Differences wrap.
+// In order, the window oldest..=highest is at most a ring: a new segment takes a free slot
+// unless the ring is full, and then forgets the oldest, which must be more than one before the
+// current; the highest's slot is its own already. So the inputs meet only equalities; the
+// rest is the registers' own.
 wire any_write = write_span || write_shape || write_axis;
 wire axis_exists = {{AXIS_EXISTS}};                // seg_axis is an axis of the design
-wire write_ok = forward && (after_current < RING) && (!write_axis || axis_exists);
-wire extend_ok = forward && (after_oldest < RING);
+wire pending = highest != last;                    // written, not yet in the path
+wire is_next = seg_index == next_highest;
+wire is_highest = seg_index == highest && pending;
+wire [PATH_INDEX_BITS-1:0] span_held = highest - oldest;
+wire [PATH_INDEX_BITS-1:0] ahead_of_current = next_highest - k;
+wire full = span_held == RING - ONE_INDEX;
+wire room = !full || (ahead_of_current < RING - ONE_INDEX);
+wire write_ok = (is_highest || (is_next && room)) && (!write_axis || axis_exists);
+wire write_taken = !reset && any_write && write_ok;
+wire extend_ok = seg_index == highest && pending;
 wire is_empty = (last + ONE_INDEX) == oldest;
+
+// A write taken is registered (w_*) and made on the next clock: the block RAM's write enables
+// and data come from registers (routed timing). The slot is safe a clock later: a write never
+// takes the slot of the current segment or the one before it, and a seek steps back at most
+// one segment per 8 clocks.
+reg w_span = 1'b0, w_shape = 1'b0, w_axis = 1'b0;
+reg [PATH_SLOT_BITS-1:0] w_slot = {PATH_SLOT_BITS{1'b0}};
+reg [AXIS_BITS-1:0] w_axis_k = {AXIS_BITS{1'b0}};
+reg [2*X_BITS-1:0] w_span_d = {2*X_BITS{1'b0}};
+reg [SHAPE_BITS-1:0] w_shape_d = {SHAPE_BITS{1'b0}};
+reg [AXIS_WORD_BITS-1:0] w_axis_d = {AXIS_WORD_BITS{1'b0}};
 
 always @(posedge clock) begin
    span_m <= span_mem[slot];
@@ -91,17 +121,23 @@ always @(posedge clock) begin
    shape_q <= shape_m;
    axis_q <= axis_m;
    a_q <= a_m;
-   if (!reset && any_write && write_ok) begin
-      if (write_span) span_mem[write_slot] <= {seg_start, seg_length};
-      if (write_shape) shape_mem[write_slot] <= {seg_arc, seg_ccw, seg_plane_first, seg_plane_second,
-                                                 seg_centre_first, seg_centre_second, seg_radius,
-                                                 seg_growth, seg_start_angle, seg_rate};
-      if (write_axis) axis_mem[{write_slot, seg_axis}] <= {seg_from, seg_share};
-   end
+   if (w_span) span_mem[w_slot] <= w_span_d;
+   if (w_shape) shape_mem[w_slot] <= w_shape_d;
+   if (w_axis) axis_mem[{w_slot, w_axis_k}] <= w_axis_d;
+   w_span <= write_taken && write_span;
+   w_shape <= write_taken && write_shape;
+   w_axis <= write_taken && write_axis;
+   w_slot <= write_slot;
+   w_axis_k <= seg_axis;
+   w_span_d <= {seg_start, seg_length};
+   w_shape_d <= {seg_arc, seg_ccw, seg_plane_first, seg_plane_second, seg_centre_first,
+                 seg_centre_second, seg_radius, seg_growth, seg_start_angle, seg_rate};
+   w_axis_d <= {seg_from, seg_share};
 end
 
 // ---- The seek -----------------------------------------------------------------------------
 reg [3:0] state = S_IDLE;
+reg [1:0] moved = 2'b00;                          // the seek moved on (bit 0), back (bit 1)
 reg fresh = 1'b0;                                 // a computation ended since the last commit
 reg [X_BITS-1:0] s_q = {X_BITS{1'b0}};            // the path length latched at the tick
 reg [X_BITS-1:0] r = {X_BITS{1'b0}};              // s - start
@@ -124,8 +160,9 @@ wire [CELL_BITS-1:0] r_cells = r[X_BITS-1:FRAC_BITS];
 wire [CELL_BITS-1:0] past_cells = past[X_BITS-1:FRAC_BITS];
 // Below a cell before the path's first segment, or below the start of any other.
 wire under = first ? under_cell : below;
-// More than a cell beyond the last segment's end.
-wire over = at_last && over_cell;
+// More than a cell beyond the last segment's end, or beyond another's (a seek stopped at a
+// gap between spans).
+wire over = at_last ? over_cell : beyond;
 wire [X_BITS-1:0] length_and_cell = {span_length[X_BITS-1:FRAC_BITS] + ONE_CELL,
                                      span_length[FRAC_BITS-1:0]};
 
@@ -139,6 +176,8 @@ always @(posedge clock) begin
       k <= {PATH_INDEX_BITS{1'b0}};
       oldest <= {PATH_INDEX_BITS{1'b0}};
       last <= {PATH_INDEX_BITS{1'b1}};
+      highest <= {PATH_INDEX_BITS{1'b1}};
+      next_highest <= {PATH_INDEX_BITS{1'b0}};
       whole <= 1'b1;
       loaded_valid <= 1'b0;
       fresh <= 1'b0;
@@ -146,8 +185,12 @@ always @(posedge clock) begin
       refused_q <= 1'b0;
    end else begin
       // The host's side.
-      if (any_write && write_ok && !(after_oldest < RING)) begin
-         oldest <= seg_index - (RING - ONE_INDEX);   // the slot's segment is forgotten
+      if (write_taken && is_next) begin
+         highest <= seg_index;
+         next_highest <= seg_index + ONE_INDEX;
+      end
+      if (write_taken && is_next && full) begin
+         oldest <= oldest + ONE_INDEX;                 // the slot's segment is forgotten
          whole <= 1'b0;
       end
       if ((any_write && !write_ok) || (extend && !extend_ok)) refused_q <= 1'b1;
@@ -161,6 +204,7 @@ always @(posedge clock) begin
          end
          if (!is_empty) begin
             s_q <= s;
+            moved <= 2'b00;
             a_read <= {AXIS_BITS{1'b0}};
             state <= S_READ;
          end
@@ -188,15 +232,20 @@ always @(posedge clock) begin
          over_cell <= ($signed(past_cells) >= $signed(ONE_CELL)) && (past != CELL);
          state <= S_DECIDE;
       end
-      S_DECIDE: if (below && !at_oldest) begin
+      // A seek never turns back (spans end to end never need it; a gap between two would
+      // make it go to and fro): it stops where it would.
+      S_DECIDE: if (below && !at_oldest && !moved[0]) begin
          k <= k - ONE_INDEX;
+         moved[1] <= 1'b1;
          state <= S_READ;
-      end else if (beyond && !at_last) begin
+      end else if (beyond && !at_last && !moved[1]) begin
          k <= k + ONE_INDEX;
+         moved[0] <= 1'b1;
          state <= S_READ;
       end else begin
          if (under) offset_q <= first ? MINUS_CELL : {X_BITS{1'b0}};
-         else if (over) offset_q <= length_and_cell;
+         else if (over && at_last) offset_q <= length_and_cell;
+         else if (over) offset_q <= span_length;
          else offset_q <= r;
          if (loaded_valid && loaded == k) begin
             start_q <= 1'b1;

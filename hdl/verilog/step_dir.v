@@ -12,7 +12,7 @@ localparam [1:0] P_IDLE = 2'd0, P_SETUP = 2'd1, P_HIGH = 2'd2, P_LOW = 2'd3;
 reg [1:0] phase = P_IDLE;
 reg [STEP_TIMER_BITS-1:0] timer = {STEP_TIMER_BITS{1'b0}};   // clocks left in the phase, minus one
 reg dir_q = 1'b0, step_q = 1'b0, overrun_q = 1'b0;
-reg due_q = 1'b0;                                  // a step not yet begun was due
+reg due_q = 1'b0;                                  // a step was due that did not begin
 reg [POSITION_BITS-1:0] up = {POSITION_BITS{1'b0}};     // the next upward step's edge
 reg [POSITION_BITS-1:0] down = {POSITION_BITS{1'b0}};   // a downward step is due below it
 reg [POSITION_BITS-1:0] count = {POSITION_BITS{1'b0}};  // steps issued since enabled
@@ -53,7 +53,9 @@ always @(posedge clock) begin
       down <= position;
       count <= {POSITION_BITS{1'b0}};
    end else begin
-      due_q <= enable && (want_up || want_down);
+      // A step is due that does not begin on this edge (in P_IDLE with the direction right,
+      // it does).
+      due_q <= enable && (want_up || want_down) && !(phase == P_IDLE && dir_q == want_up);
       if (!enable) overrun_q <= 1'b0;
       else if (!to_next_up[POSITION_BITS-1] || to_next_down[POSITION_BITS-1]) overrun_q <= 1'b1;
       case (phase)

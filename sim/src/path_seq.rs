@@ -94,8 +94,11 @@ pub struct PathSeqReport {
     pub moves: u64,
     /// Commits.
     pub commits: u64,
-    /// Commits checked against the rule.
+    /// Commits checked against the rule (every one).
     pub checked: u64,
+    /// Of those, how many had the path length sent below the oldest segment kept (at the end
+    /// of a run whose ring wrapped).
+    pub below_oldest: u64,
     /// Of those, the first that differed (must be None).
     pub rule_error: Option<String>,
     /// Writes or extensions that must be refused, and of those how many were.
@@ -139,6 +142,9 @@ struct Host {
     /// The run has ended: clocks left before the next run's reset (the last tick's commit
     /// is still checked).
     ending: Option<u32>,
+    /// At the end of a run whose ring wrapped: the path length has been sent below the oldest
+    /// segment kept, and the run ends with the tick after that computation.
+    dived: bool,
 }
 
 /// The computation running or last ended: its `s`, the path's length in segments when it
@@ -148,6 +154,9 @@ struct Computation {
     s: i128,
     extended: usize,
     changed: bool,
+    /// The start of the oldest segment kept, when segments have been forgotten and `s` was
+    /// sent below it (the sequencer stays on that segment's start).
+    floor: Option<i128>,
 }
 
 /// The words that write segment `index` of `g` for `axes` axes (span and shape together or
@@ -209,7 +218,6 @@ pub(crate) fn segment_words(
 /// A write or extension that the sequencer must refuse, given its registers.
 fn probe(rng: &mut impl Rng, seq: &PathSequencer, axes: u8) -> PathSeqInputs {
     let r = seq.reg;
-    let ring = PATH_SLOTS as u16;
     match rng.gen_range(0..4) {
         // A segment of the path (the current one) rewritten.
         0 => PathSeqInputs {
@@ -217,15 +225,15 @@ fn probe(rng: &mut impl Rng, seq: &PathSequencer, axes: u8) -> PathSeqInputs {
             write_span: true,
             ..Default::default()
         },
-        // A segment a whole ring ahead of the current one.
+        // A segment out of order: past the one after the highest written.
         1 => PathSeqInputs {
-            seg_index: r.k.wrapping_add(ring + rng.gen_range(0..100)),
+            seg_index: r.highest.wrapping_add(2 + rng.gen_range(0..100)),
             write_shape: true,
             ..Default::default()
         },
         // An axis the design lacks (or, with every axis, an extension backwards).
         2 if axes < MAX_AXES as u8 => PathSeqInputs {
-            seg_index: r.last.wrapping_add(1),
+            seg_index: r.highest.wrapping_add(1),
             write_axis: true,
             seg_axis: rng.gen_range(axes..MAX_AXES as u8),
             ..Default::default()
@@ -235,9 +243,9 @@ fn probe(rng: &mut impl Rng, seq: &PathSequencer, axes: u8) -> PathSeqInputs {
             extend: true,
             ..Default::default()
         },
-        // An extension past the ring.
+        // An extension past the highest written.
         _ => PathSeqInputs {
-            seg_index: r.oldest.wrapping_add(ring + rng.gen_range(0..100)),
+            seg_index: r.highest.wrapping_add(1 + rng.gen_range(0..100)),
             extend: true,
             ..Default::default()
         },
@@ -289,12 +297,22 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
             if c.is_none() && r.rule_error.is_none() {
                 r.rule_error = Some(format!("clock {}: a commit with no computation", r.clocks));
             }
-            if let Some(c) = c.filter(|c| !c.changed) {
-                let prefix = Path {
-                    segments: h.path.segments[..c.extended].to_vec(),
-                };
-                let expect = prefix.at(c.s).expect("a segment");
+            if let Some(c) = c {
+                // The path as it stood when the computation decided: as it began, or (the
+                // path extended meanwhile) as any extension since left it.
+                let s_at = c.floor.map_or(c.s, |f| c.s.max(f));
+                let mut expect = Vec::new();
+                for extended in c.extended..=if c.changed { h.extended } else { c.extended } {
+                    let prefix = Path {
+                        segments: h.path.segments[..extended].to_vec(),
+                    };
+                    expect = prefix.at(s_at).expect("a segment");
+                    if expect == next_pos {
+                        break;
+                    }
+                }
                 r.checked += 1;
+                r.below_oldest += u64::from(c.floor.is_some_and(|f| c.s < f));
                 if expect != next_pos && r.rule_error.is_none() {
                     r.rule_error = Some(format!(
                         "clock {}: s = {} on {} segments: committed {next_pos:?}, the rule says {expect:?}",
@@ -348,6 +366,7 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     queue: Default::default(),
                     probe_at: rng.gen_bool(0.2).then(|| rng.gen_range(1..30)),
                     ending: None,
+                    dived: false,
                 });
                 r.runs += 1;
                 next_pos.fill(0);
@@ -377,7 +396,7 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     probe_given = true;
                     r.probes += 1;
                 } else if h.written < n
-                    && h.written < lowest(k_low, o.segment) + PATH_SLOTS as usize
+                    && h.written < lowest(k_low, o.segment) + PATH_SLOTS as usize - 1
                     && rng.gen_bool(0.3)
                 {
                     let k = h.written;
@@ -397,7 +416,16 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                 }
                 // The ticks.
                 until_tick = until_tick.saturating_sub(1);
-                if until_tick == 0 && h.extended > 0 {
+                if until_tick == 0 && h.dived && o.running {
+                    until_tick = 1;
+                } else if until_tick == 0 && h.dived {
+                    // The dive's positions are committed on this tick; the run ends.
+                    i.tick = true;
+                    i.s = s;
+                    r.ticks += 1;
+                    end_of_run(&mut r, &seq, probed);
+                    h.ending = Some(3);
+                } else if until_tick == 0 && h.extended > 0 {
                     let total: i128 =
                         h.starts[h.extended - 1] + h.path.segments[h.extended - 1].length;
                     let here = h.starts.partition_point(|&st| st <= s).max(1) - 1;
@@ -421,6 +449,19 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     i.s = s;
                     r.ticks += 1;
                     run_ticks += 1;
+                    // The end of a run whose ring wrapped, the path extended to its end and
+                    // every word written: once, the path length below the oldest segment kept.
+                    let oldest = n.saturating_sub(PATH_SLOTS as usize);
+                    let dive = h.extended == n
+                        && n > PATH_SLOTS as usize
+                        && s >= total
+                        && h.queue.is_empty()
+                        && !o.running;
+                    if dive {
+                        s = h.starts[oldest] - rng.gen_range(1..=4 * cell);
+                        i.s = s;
+                        h.dived = true;
+                    }
                     if o.running {
                         // Dropped (late): the computation running goes on.
                     } else {
@@ -428,9 +469,10 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                             s,
                             extended: h.extended,
                             changed: i.extend,
+                            floor: dive.then(|| h.starts[oldest]),
                         });
                     }
-                    let early = rng.gen_bool(0.02);
+                    let early = rng.gen_bool(0.02) && !dive;
                     r.early += u64::from(early);
                     until_tick = if early {
                         rng.gen_range(1..shortest)
@@ -438,14 +480,9 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                         period
                     };
                     // A run ends once its path is played and left behind.
-                    if h.extended == n && s >= total && rng.gen_bool(0.2) && h.queue.is_empty() {
-                        r.late_runs += u64::from(seq.outputs().late);
-                        if seq.reg.oldest != 0 || !seq.reg.whole {
-                            r.wrapped += 1;
-                        }
-                        if !probed && seq.outputs().refused {
-                            r.false_refusals += 1;
-                        }
+                    let ends = h.extended == n && s >= total && h.queue.is_empty();
+                    if ends && n <= PATH_SLOTS as usize && rng.gen_bool(0.2) {
+                        end_of_run(&mut r, &seq, probed);
                         h.ending = Some(3);
                     }
                 }
@@ -490,4 +527,12 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
 fn lowest(k_low: usize, segment: u16) -> usize {
     let off = i64::from(segment.wrapping_sub(k_low as u16) as i16);
     (k_low as i64 + off.min(0)).max(0) as usize
+}
+
+/// A run's end in the report: whether it was late, wrapped, or refused with no probe.
+fn end_of_run(r: &mut PathSeqReport, seq: &PathSequencer, probed: bool) {
+    let o = seq.outputs();
+    r.late_runs += u64::from(o.late);
+    r.wrapped += u64::from(seq.reg.oldest != 0 || !seq.reg.whole);
+    r.false_refusals += u64::from(!probed && o.refused);
 }

@@ -5,18 +5,19 @@
 //!
 //! The stream, run after run (each begins with a reset and the drives disabled): a path of 1
 //! to 6 lines, arcs and helices from the host's planner (elements up to about 10³ or 10⁴ LSB,
-//! so that a run is some hundreds of ticks), written word by word and extended; two ticks at the start (the axes
-//! take the path's start), then the drives enabled, each axis with its own step length (1–8
-//! LSB) and a common pulse timing (1–6 clocks each); ticks `worst_clocks` (for a tick that
-//! crosses every segment) to 1 000 clocks more apart, the path length moving on by up to what the slowest axis's pulses can follow
-//! in a tick (now and then staying, or back within a cell), to the end and 20 ticks more. A
-//! fifth of the runs move 4 to 8 times faster than the pulses can follow.
+//! so that a run is some hundreds of ticks), written word by word and extended; two ticks at
+//! the start (the axes take the path's start), then the drives enabled, each axis with its own
+//! step length (1–8 LSB) and a common pulse timing (1–6 clocks each); ticks `worst_clocks` (for
+//! a tick that crosses every segment) to 1 000 clocks more apart, the path length moving on by
+//! up to what the slowest axis's pulses can follow in a tick (now and then staying, or back
+//! within a cell), to the end and 20 ticks more. A fifth of the runs move 4 to 8 times faster
+//! than the pulses can follow.
 //!
 //! Checked beside the lockstep, from the fabric's lines alone: in a run within the rate no
 //! axis raises `overrun` and each axis's steps (rising edges, signed by its direction line)
 //! equal `⌊(end − start) / step⌋` of its position at the path's end and at its start, by the
-//! rule (`Path::at`); a run with a tick that jumps, by the rule, further than an axis's
-//! pulses can follow in a tick raises `overrun`.
+//! rule (`Path::at`); in a run with a tick that moves an axis, by the rule, further than its
+//! pulses can follow in a tick, that axis raises `overrun`.
 
 use std::path::Path as FsPath;
 
@@ -140,10 +141,10 @@ struct Run {
     /// Each axis's position at the start (whole LSB), and steps counted on its lines.
     start: Vec<i64>,
     counted: Vec<i64>,
-    /// The rule's positions at the last tick's `s`, and whether a tick jumped further than
-    /// an axis's pulses can follow.
+    /// The rule's positions at the last tick's `s`, and the axes a tick moved further than
+    /// their pulses can follow (bit k).
     at: Vec<i128>,
-    must: bool,
+    must: u8,
 }
 
 /// Runs the stream of `cfg` on the library `library` (built by
@@ -244,7 +245,7 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
                     start: vec![0; n],
                     counted: vec![0; n],
                     at: Vec::new(),
-                    must: false,
+                    must: 0,
                 });
                 i = PathSteppersInputs {
                     reset: true,
@@ -292,7 +293,9 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
                             for (k, (&x, &y)) in at.iter().zip(&run.at).enumerate() {
                                 let step = i64::from((run.drives.step_lsb >> (16 * k)) as u16);
                                 let jump = (whole(x) - whole(y)).abs() / step;
-                                run.must |= jump >= most as i64 + 2;
+                                if jump >= most as i64 + 2 {
+                                    run.must |= 1 << k;
+                                }
                             }
                         }
                         run.at = at;
@@ -385,9 +388,10 @@ fn judge(run: &Run, flags: (u8, bool, bool), r: &mut PathSteppersReport) {
     if late || refused {
         fail(r, format!("late {late}, refused {refused}"));
     }
-    if run.must {
+    if run.must != 0 {
+        // Every axis that could not follow says so.
         r.must += 1;
-        r.flagged += u64::from(overrun != 0);
+        r.flagged += u64::from(overrun & run.must == run.must);
     }
     if run.fast {
         r.fast += 1;

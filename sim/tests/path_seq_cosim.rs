@@ -57,7 +57,8 @@ fn a_one_bit_fault_in_any_output_is_found() {
 }
 
 /// The stream reaches the logic: a fabric with one line of its Verilog altered (a borrow
-/// dropped, the clamp a cell before the path's start lost, no step back) disagrees with the
+/// dropped, the clamp a cell before the path's start lost, no step back, the clamp below the
+/// oldest segment kept taken as the path's start's) disagrees with the
 /// model within the suite's clocks.
 #[test]
 fn an_altered_line_of_the_verilog_is_found() {
@@ -72,6 +73,10 @@ fn an_altered_line_of_the_verilog_is_found() {
             "MINUS_CELL = {X_BITS{1'b0}};",
         ),
         ("k <= k - ONE_INDEX;", "k <= k;"),
+        (
+            "if (under) offset_q <= first ? MINUS_CELL : {X_BITS{1'b0}};",
+            "if (under) offset_q <= MINUS_CELL;",
+        ),
     ] {
         assert_eq!(good.matches(from).count(), 1, "{from}");
         let bad = good.replace(from, to);

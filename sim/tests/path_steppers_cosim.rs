@@ -22,7 +22,11 @@ fn fabric_model_and_drives_agree() {
         eprintln!("{axes} axes: {r:?}");
         assert_eq!(r.mismatch, None);
         assert_eq!(r.violation, None);
-        assert!(r.checked >= 3 && r.steps > 10_000, "{r:?}");
+        // Every run within the rate is checked (the last may be cut short by the clocks).
+        assert!(
+            r.checked + r.fast + 1 >= r.runs && r.steps > 10_000,
+            "{r:?}"
+        );
         // Faster than the pulses follow, an axis says so.
         assert!(r.fast > 0 && r.must > 0 && r.flagged == r.must, "{r:?}");
     }

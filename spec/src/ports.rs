@@ -262,7 +262,7 @@ macro_rules! with_path_sequencer_ports {
                     reset: bit[1] bool, "Synchronous reset, active high: the path is empty (segment 0 is the next written), idle, the flags cleared.";
                 }
                 write {
-                    seg_index: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the writes below are for (wrapping index; accepted after the path's last segment and within the ring ahead of the current one, else `refused`).";
+                    seg_index: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the writes below are for (wrapping index; accepted in order, the segment after the highest written or the highest while it is not in the path, into a free slot or one whose segment is more than one before the current; else `refused`).";
                     write_span: bit[1] bool, "Write the segment's span (`seg_start`, `seg_length`).";
                     seg_start: bits[$crate::widths::X_BITS] i128, "The path length at the segment's start, raw (the chain's position format).";
                     seg_length: bits[$crate::widths::X_BITS] i128, "The segment's length, raw (≥ 0).";
@@ -283,7 +283,7 @@ macro_rules! with_path_sequencer_ports {
                     seg_share: bits[$crate::widths::SHARE_BITS] i128, "The axis's share of the length (62 fraction bits).";
                 }
                 extend {
-                    extend: bit[1] bool, "The path now ends with segment `seg_index` (it and those before it written; accepted ahead of the last and within the ring, else `refused`).";
+                    extend: bit[1] bool, "The path now ends with segment `seg_index`: every segment written is taken in, so it must be the highest written, on a clock after its last write (else `refused`). Every word of those segments must have been written.";
                 }
                 tick {
                     tick: bit[1] bool, "A tick: commit the last computation's axes and compute those at `s` (one-clock pulse).";
@@ -424,7 +424,7 @@ macro_rules! with_step_dir_ports {
                 status {
                     steps: bits[$crate::widths::POSITION_BITS] u32, "Steps issued since enabled, signed (wraps).";
                     overrun: bit[1] bool, "The position ran more than one step ahead of the pulses (sticky until disabled or reset): the axis moves faster than the pulse rate allows.";
-                    due: bit[1] bool, "On the last clock a step was due that had not begun (enabled, the position a step or more from the grid): the pulses are behind the position.";
+                    due: bit[1] bool, "On the last edge a step was due that did not begin there (enabled, the position a step or more from the grid): the pulses are behind the position.";
                 }
             }
         }

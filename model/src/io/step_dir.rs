@@ -60,7 +60,7 @@ pub struct StepDir {
     pub steps: u32,
     /// The position ran more than a step ahead of the pulses.
     pub overrun: bool,
-    /// On the last clock a step was due that had not begun.
+    /// On the last edge a step was due that did not begin there.
     pub due: bool,
 }
 
@@ -125,7 +125,10 @@ impl StepDir {
         let ahead = |a: u32, b: u32| (a.wrapping_sub(b) as i32) >= 0;
         let want_up = ahead(i.position, old.up);
         let want_down = !ahead(i.position, old.down);
-        self.due = i.enable && (want_up || want_down);
+        // A step is due that does not begin on this edge (in Idle with the direction right,
+        // it does).
+        let begins = old.phase == Phase::Idle && old.dir == want_up;
+        self.due = i.enable && (want_up || want_down) && !begins;
         if !i.enable {
             self.overrun = false;
         } else if ahead(i.position, old.up.wrapping_add(k))

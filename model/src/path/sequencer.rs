@@ -6,33 +6,37 @@
 //! **The ring.** [`PATH_SLOTS`] segments, each a span (its start on the path and its length),
 //! a shape (the interpolator's shape ports) and one word per axis (start and share), all in
 //! memories with a registered read (block RAM). Segments have wrapping [`PATH_INDEX_BITS`]-bit
-//! indices, so a path may be as long as the host likes: it writes segment `i` and then
-//! `extend`s the path to it. The window of segments the sequencer may use is `oldest..=last`:
-//! a write is accepted only after `last` and less than [`PATH_SLOTS`] ahead of the current
-//! segment (so it never overwrites the current one or any after it), and moves `oldest` past
-//! the segment whose slot it takes; an extension is accepted ahead of `last` and within the
-//! ring. Anything else sets the sticky `refused`.
+//! indices, so a path may be as long as the host likes: it writes segment `i`, every word, and
+//! then `extend`s the path to it. The window of segments the sequencer may use is
+//! `oldest..=last`. A write is accepted in order (to the segment after the highest written
+//! since reset, or to the highest while it is not yet in the path) and into a free slot or one
+//! whose segment is more than one before the current (so neither the current segment nor the
+//! one before it, where a seek may step back on that very clock, is overwritten); it moves
+//! `oldest` past the segment whose slot it takes. An extension takes in every segment written:
+//! its index must be the highest written, and it comes on a clock after that segment's last
+//! write. Anything else sets the sticky `refused`.
 //!
 //! **A tick.** On `tick`, when idle: `commit` (one clock) if a computation has ended since
 //! the last, so the axes take the positions of the tick before, all at once; then, unless the
-//! path is empty, `s` is latched and the seek runs. Each step reads the current segment's
-//! span (two clocks), forms `r = s − start` and `r − length` (each a [`X_BITS`]-bit difference over two
-//! clocks, its halves split at [`SPLIT`], for routed timing; their comparisons with a cell on
-//! a clock of their own) and moves back a segment if `r < 0`
-//! (unless at `oldest`) or on if `r ≥ length` (unless at `last`). Where it stops it clamps `r`
-//! as [`super::interp::Path::at`] does: at the path's first segment (when no segment has been
-//! forgotten since reset) back to a cell before its start, at `last` up to a cell beyond its
-//! end, elsewhere to the segment. If the interpolator does not hold that segment yet, the
-//! sequencer loads its shape with axis 0, then the other axes one per clock (axis 0 twice: the
-//! read takes two clocks), then starts it at the offset and waits for `done`. Every memory
-//! read passes two registers (the block RAM's own and one more), so that the block RAM's slow
-//! output drives only a register: routed timing. A `tick` while all this runs is `late` (sticky): the tick is
-//! dropped and the axes keep their positions.
+//! path is empty, `s` is latched and the seek runs. Each step reads the current segment's span
+//! (two clocks: every read passes the block RAM's register and one more, so that its slow
+//! output drives only a register), forms `r = s − start` and `r − length` (each a
+//! [`X_BITS`]-bit difference over two clocks, its halves split at [`SPLIT`]; their comparisons
+//! with a cell on a clock of their own: routed timing) and moves back a segment if `r < 0`
+//! (unless at `oldest`) or on if `r ≥ length` (unless at `last`), never both ways in one seek
+//! (spans end to end never need it; a gap between two, a host's error, would make it go to and
+//! fro). Where it stops it clamps `r` as [`super::interp::Path::at`] does: at the path's first
+//! segment (when none has been forgotten since reset) back to a cell before its start, at
+//! `last` up to a cell beyond its end, elsewhere to the segment (so below the oldest segment
+//! kept, at its start). If the interpolator does not hold that segment yet, the sequencer loads
+//! its shape with axis 0, then the other axes one per clock (axis 0 twice: the read takes two
+//! clocks), then starts it at the offset and waits for `done`. A `tick` while all this runs is
+//! `late` (sticky): the tick is dropped and the axes keep their positions.
 //!
-//! So, while `s` stays within the window, the positions committed at a tick are
-//! `Path::at(s)` of the tick before, on the segments written (tested against `Path::at` in
-//! this module and on every tick of the co-simulation's stream, `snapgen_sim::path_seq`).
-//! [`worst_clocks`] bounds the clocks a tick needs.
+//! So, while `s` stays within the window, the positions committed at a tick are `Path::at(s)`
+//! of the tick before, on the segments written (tested against `Path::at` in this module and
+//! at every commit of the co-simulation's stream, `snapgen_sim::path_seq`). [`worst_clocks`]
+//! bounds the clocks a tick needs.
 
 use snapgen_spec::widths::{
     AXIS_BITS, FRAC_BITS, MAX_AXES, PATH_INDEX_BITS, PATH_SLOTS, RATE_BITS, SHARE_BITS, X_BITS,
@@ -70,23 +74,23 @@ pub enum State {
     Read = 1,
     /// They pass the read's second register (for routed timing: the block RAM's slow output
     /// drives nothing but a register).
-    Fetch = 10,
+    Fetch = 2,
     /// `s − start`, low half.
-    OffsetLow = 2,
+    OffsetLow = 3,
     /// `s − start`, high half.
-    OffsetHigh = 3,
+    OffsetHigh = 4,
     /// `r − length`, low half.
-    PastLow = 4,
+    PastLow = 5,
     /// `r − length`, high half.
-    PastHigh = 5,
+    PastHigh = 6,
     /// `r` and `r − length` compared with a cell (registered for routed timing).
-    Judge = 11,
+    Judge = 7,
     /// Back, on, or here (the offset clamped).
-    Decide = 6,
+    Decide = 8,
     /// The axes are offered to the interpolator (`load_axis`; the shape with the first).
-    LoadAxis = 7,
+    LoadAxis = 9,
     /// The interpolator computes (`start` on the first clock).
-    Wait = 8,
+    Wait = 10,
 }
 
 /// A segment's shape word (the interpolator's shape ports, at their widths).
@@ -114,9 +118,22 @@ pub struct ShapeWord {
     pub rate: i128,
 }
 
+/// A write taken on one clock, made on the next (the fabric registers the host's write before
+/// the block RAM takes it: routed timing).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Pending {
+    slot: usize,
+    span: Option<(i128, i128)>,
+    shape: Option<ShapeWord>,
+    /// The axis and its word.
+    axis: Option<(usize, (i128, i128))>,
+}
+
 /// The ring's memories (block RAM in the fabric).
 #[derive(Clone, Debug, PartialEq, Eq)]
 struct Ring {
+    /// The write taken on the last clock.
+    pending: Pending,
     /// Spans: (start, length) per slot.
     span: Vec<(i128, i128)>,
     /// Shapes per slot.
@@ -136,6 +153,10 @@ pub struct Registers {
     pub oldest: u16,
     /// The path's last segment (`oldest − 1` while empty).
     pub last: u16,
+    /// The highest segment written since reset (`last` or after it; `oldest − 1` before any).
+    pub highest: u16,
+    /// The seek's moves this tick: it moved on (bit 0), back (bit 1).
+    pub moved: u8,
     /// No segment has been forgotten since reset (`oldest` is the path's first).
     pub whole: bool,
     /// The interpolator holds segment [`Registers::loaded`].
@@ -205,6 +226,13 @@ pub fn worst_clocks(axes: u8, segments: u64) -> u64 {
     STEP_CLOCKS * (segments + 1) + 1 + u64::from(axes) + engine::clocks(true, axes) + 3
 }
 
+/// `a − b` as the fabric forms it over two clocks: the low [`SPLIT`] bits and their borrow
+/// (`low`, from the clock before), then the high bits less the borrow, joined.
+fn join(a: i128, b: i128, low: (u128, bool)) -> i128 {
+    let high = (a >> SPLIT) - (b >> SPLIT) - i128::from(low.1);
+    wrap((high << SPLIT) | low.0 as i128, X_BITS)
+}
+
 /// `a − b` as the fabric's wrapping index difference (unsigned).
 fn ahead(a: u16, b: u16) -> u16 {
     a.wrapping_sub(b)
@@ -220,6 +248,7 @@ impl PathSequencer {
         Ok(PathSequencer {
             axes,
             ring: Ring {
+                pending: Pending::default(),
                 span: vec![(0, 0); slots],
                 shape: vec![ShapeWord::default(); slots],
                 axis: vec![(0, 0); slots * MAX_AXES as usize],
@@ -229,6 +258,8 @@ impl PathSequencer {
                 k: 0,
                 oldest: 0,
                 last: u16::MAX,
+                highest: u16::MAX,
+                moved: 0,
                 whole: true,
                 loaded_valid: false,
                 loaded: 0,
@@ -301,6 +332,17 @@ impl PathSequencer {
         r.axis_m = self.ring.axis[slot * MAX_AXES as usize + usize::from(old.a_read)];
         r.a_m = old.a_read;
         (r.span_q, r.shape_q, r.axis_q, r.a_q) = (old.span_m, old.shape_m, old.axis_m, old.a_m);
+        // The write taken on the last clock lands (after the reads: read before write).
+        let w = std::mem::take(&mut self.ring.pending);
+        if let Some(v) = w.span {
+            self.ring.span[w.slot] = v;
+        }
+        if let Some(v) = w.shape {
+            self.ring.shape[w.slot] = v;
+        }
+        if let Some((k, v)) = w.axis {
+            self.ring.axis[w.slot * MAX_AXES as usize + k] = v;
+        }
         self.out.load_shape = false;
         self.out.load_axis = false;
         self.out.start = false;
@@ -310,6 +352,7 @@ impl PathSequencer {
             r.k = 0;
             r.oldest = 0;
             r.last = u16::MAX;
+            r.highest = u16::MAX;
             r.whole = true;
             r.loaded_valid = false;
             r.fresh = false;
@@ -322,22 +365,37 @@ impl PathSequencer {
         self.publish();
     }
 
-    /// The host's side: writes and extensions, judged on the registers before the clock.
+    /// The host's side: writes and extensions, judged on the registers before the clock (an
+    /// extension to a segment comes on a clock after its last write).
     fn write(&mut self, old: &Registers, i: &PathSeqInputs) {
         let index = i.seg_index;
         let slots = PATH_SLOTS as u16;
-        let forward = |d: u16| d != 0 && d < 1 << 15;
         let any = i.write_span || i.write_shape || i.write_axis;
-        let in_ring = forward(ahead(index, old.last)) && ahead(index, old.k) < slots;
+        // In order: the segment after the highest written, or more words of the highest while
+        // it is not yet in the path; and into a free slot, or one whose segment is more than
+        // one before the current (so neither the current segment nor the one before it, where
+        // a seek may step back on this very clock, is overwritten).
+        // (In order, the window oldest..=highest is at most a ring: a new segment takes a free
+        // slot unless the ring is full, and then forgets the oldest, which must be more than
+        // one before the current; the highest's slot is its own already.)
+        let is_next = index == old.highest.wrapping_add(1);
+        let is_highest = index == old.highest && old.highest != old.last;
+        let full = ahead(old.highest, old.oldest) == slots - 1;
+        let in_order = is_next || is_highest;
+        let in_ring = is_highest || !full || ahead(index, old.k) < slots - 1;
         let axis = i.seg_axis & ((1 << AXIS_BITS) - 1);
         let axis_ok = !i.write_axis || axis < self.axes;
-        if any && in_ring && axis_ok {
-            let slot = Self::slot(index);
+        if any && in_order && in_ring && axis_ok {
+            if is_next {
+                self.reg.highest = index;
+            }
+            let w = &mut self.ring.pending;
+            w.slot = Self::slot(index);
             if i.write_span {
-                self.ring.span[slot] = (wrap(i.seg_start, X_BITS), wrap(i.seg_length, X_BITS));
+                w.span = Some((wrap(i.seg_start, X_BITS), wrap(i.seg_length, X_BITS)));
             }
             if i.write_shape {
-                self.ring.shape[slot] = ShapeWord {
+                w.shape = Some(ShapeWord {
                     arc: i.seg_arc,
                     ccw: i.seg_ccw,
                     plane_first: i.seg_plane_first & ((1 << AXIS_BITS) - 1),
@@ -348,22 +406,26 @@ impl PathSequencer {
                     growth: wrap(i.seg_growth, SHARE_BITS),
                     start_angle: i.seg_start_angle,
                     rate: wrap(i.seg_rate, RATE_BITS),
-                };
+                });
             }
             if i.write_axis {
-                self.ring.axis[slot * MAX_AXES as usize + usize::from(axis)] =
-                    (wrap(i.seg_from, X_BITS), wrap(i.seg_share, SHARE_BITS));
+                w.axis = Some((
+                    usize::from(axis),
+                    (wrap(i.seg_from, X_BITS), wrap(i.seg_share, SHARE_BITS)),
+                ));
             }
-            if ahead(index, old.oldest) >= slots {
-                // The slot held segment `index − PATH_SLOTS`: forgotten.
-                self.reg.oldest = index.wrapping_sub(slots - 1);
+            if is_next && full {
+                // The slot held segment `index − PATH_SLOTS`, the oldest: forgotten.
+                self.reg.oldest = old.oldest.wrapping_add(1);
                 self.reg.whole = false;
             }
         } else if any {
             self.out.refused = true;
         }
         if i.extend {
-            if forward(ahead(index, old.last)) && ahead(index, old.oldest) < slots {
+            // Every segment written and not yet in the path: `seg_index` must be the highest
+            // written (the host and the fabric agree on what the path now is).
+            if index == old.highest && old.highest != old.last {
                 self.reg.last = index;
             } else {
                 self.out.refused = true;
@@ -390,6 +452,7 @@ impl PathSequencer {
                     if !empty {
                         r.s = wrap(i.s, X_BITS);
                         r.a_read = 0;
+                        r.moved = 0;
                         r.state = State::Read;
                     }
                 }
@@ -402,7 +465,7 @@ impl PathSequencer {
                 r.state = State::OffsetHigh;
             }
             State::OffsetHigh => {
-                r.r = wrap(old.s - old.span_q.0, X_BITS);
+                r.r = join(old.s, old.span_q.0, old.low);
                 r.state = State::PastLow;
             }
             State::PastLow => {
@@ -411,7 +474,7 @@ impl PathSequencer {
                 r.state = State::PastHigh;
             }
             State::PastHigh => {
-                r.past = wrap(old.r - old.span_q.1, X_BITS);
+                r.past = join(old.r, old.span_q.1, old.low);
                 r.state = State::Judge;
             }
             State::Judge => {
@@ -423,26 +486,33 @@ impl PathSequencer {
                 let (at_oldest, at_last) = (old.k == old.oldest, old.k == old.last);
                 let below = old.r < 0;
                 let beyond = old.past >= 0;
-                if below && !at_oldest {
+                // A seek never turns back (spans end to end never need it; a gap between two
+                // would make it go to and fro): it stops where it would.
+                if below && !at_oldest && old.moved & 1 == 0 {
                     r.k = old.k.wrapping_sub(1);
+                    r.moved = old.moved | 2;
                     r.state = State::Read;
-                } else if beyond && !at_last {
+                } else if beyond && !at_last && old.moved & 2 == 0 {
                     r.k = old.k.wrapping_add(1);
+                    r.moved = old.moved | 1;
                     r.state = State::Read;
                 } else {
                     let first = at_oldest && old.whole;
                     // Below a cell before the first segment's start, or below any other's.
                     let under = if first { old.under_cell } else { below };
-                    // More than a cell beyond the last segment's end.
-                    let over = at_last && old.over_cell;
+                    // More than a cell beyond the last segment's end, or beyond another's (a
+                    // seek stopped at a gap).
+                    let over = if at_last { old.over_cell } else { beyond };
                     out.offset = if under {
                         if first {
                             -cell
                         } else {
                             0
                         }
-                    } else if over {
+                    } else if over && at_last {
                         wrap(old.span_q.1 + cell, X_BITS)
+                    } else if over {
+                        old.span_q.1
                     } else {
                         old.r
                     };
@@ -717,6 +787,95 @@ mod tests {
                 "{axes}: {longest} vs {bound}"
             );
         }
+    }
+
+    #[test]
+    fn segments_are_written_in_order_and_the_one_before_the_current_is_kept() {
+        let g = |k: i128| line(vec![k << 20], vec![ONE], 1 << 20);
+        // Out of order after a reset (segment 0 is the next), and an extension past the
+        // highest written: refused.
+        let mut b = Bench::new(1);
+        b.inputs.seg_index = 5;
+        b.inputs.write_span = true;
+        b.clock();
+        assert!(b.seq.outputs().refused);
+        let mut b = Bench::new(1);
+        b.append(0, 0, &g(0));
+        b.inputs.seg_index = 2;
+        b.inputs.extend = true;
+        b.clock();
+        assert!(b.seq.outputs().refused, "segment 1 was never written");
+        // Rewriting a segment already in the path, or extending to less than every segment
+        // written: refused.
+        let mut b = Bench::new(1);
+        b.append(0, 0, &g(0));
+        b.append(1, 1 << 20, &g(1));
+        b.inputs.seg_index = 1;
+        b.inputs.write_span = true;
+        b.clock();
+        assert!(b.seq.outputs().refused, "segment 1 is in the path");
+        let mut b = Bench::new(1);
+        for k in 0..3u16 {
+            b.inputs.seg_index = k;
+            b.inputs.write_span = true;
+            b.clock();
+        }
+        b.inputs.seg_index = 1;
+        b.inputs.extend = true;
+        b.clock();
+        assert!(b.seq.outputs().refused, "segment 2 is written too");
+        // A write and the extension to it on one clock: the extension is too early.
+        let mut b = Bench::new(1);
+        b.inputs = PathSeqInputs {
+            seg_index: 0,
+            write_span: true,
+            extend: true,
+            ..Default::default()
+        };
+        b.clock();
+        assert!(b.seq.outputs().refused && b.seq.outputs().empty);
+        // The ring full ahead of segment 3: segment 3 + 63 would take the slot of segment 2,
+        // where a seek may step back, so it waits; 3 + 62 (taking segment 1's) does not.
+        let mut b = Bench::new(1);
+        for k in 0..66u16 {
+            if k == 64 {
+                b.tick(3 << 20, worst_clocks(1, 4));
+                b.tick(3 << 20, worst_clocks(1, 4));
+                assert_eq!(b.seq.reg.k, 3);
+            }
+            b.append(k, i128::from(k) << 20, &g(i128::from(k)));
+            assert!(!b.seq.outputs().refused, "segment {k}");
+        }
+        assert_eq!((b.seq.reg.oldest, b.seq.reg.whole), (2, false));
+        b.inputs.seg_index = 66;
+        b.inputs.write_span = true;
+        b.clock();
+        assert!(b.seq.outputs().refused);
+        // Stepping back from segment 3 to 2 (the one kept): the rule's positions.
+        let before = (3 << 20) - 5;
+        b.tick(before, worst_clocks(1, 4));
+        assert_eq!(b.tick(before, worst_clocks(1, 4)), g(2).at((1 << 20) - 5));
+        assert_eq!(b.seq.reg.k, 2);
+        // Below the oldest kept, the sequencer stays on its start (the path before is gone).
+        b.tick(1 << 20, worst_clocks(1, 4));
+        assert_eq!(b.tick(1 << 20, worst_clocks(1, 4)), g(2).at(0));
+        assert!(!b.seq.outputs().late);
+    }
+
+    #[test]
+    fn a_gap_between_spans_stops_the_seek_instead_of_going_to_and_fro() {
+        // Segment 1 starts 2^20 after segment 0 ends (a host's error): s in the gap.
+        let mut b = Bench::new(1);
+        let g0 = line(vec![0], vec![ONE], 1 << 20);
+        let g1 = line(vec![2 << 20], vec![ONE], 1 << 20);
+        b.append(0, 0, &g0);
+        b.append(1, 2 << 20, &g1);
+        let s = 3 << 19;
+        b.tick(s, worst_clocks(1, 2));
+        assert!(!b.seq.outputs().running, "the seek ended");
+        // On from segment 0, then it would go back: it stops on segment 1's start.
+        assert_eq!(b.tick(s, worst_clocks(1, 2)), g1.at(0));
+        assert!(!b.seq.outputs().late);
     }
 
     #[test]
