@@ -29,8 +29,8 @@ use std::path::Path as FsPath;
 use rand::{Rng, SeedableRng};
 use snapgen_model::path::engine::{load_inputs, Engine};
 use snapgen_model::path::interp::{Path, Segment};
-use snapgen_model::path::sequencer::{worst_clocks, PathSequencer};
-use snapgen_model::{InterpInputs, PathSeqInputs, PathSeqOutputs, FRAC_BITS};
+use snapgen_model::path::sequencer::{segment_writes, worst_clocks, PathSequencer};
+use snapgen_model::{PathSeqInputs, PathSeqOutputs, FRAC_BITS};
 use snapgen_spec::widths::{MAX_AXES, PATH_SLOTS};
 
 use crate::interp::random_path;
@@ -159,8 +159,8 @@ struct Computation {
     floor: Option<i128>,
 }
 
-/// The words that write segment `index` of `g` for `axes` axes (span and shape together or
-/// apart, then each axis).
+/// The words that write segment `index` of `g` for `axes` axes: the model's, the span and the
+/// shape on one clock or (half the time) on two.
 pub(crate) fn segment_words(
     rng: &mut impl Rng,
     index: u16,
@@ -168,49 +168,20 @@ pub(crate) fn segment_words(
     g: &Segment,
     axes: u8,
 ) -> Vec<PathSeqInputs> {
-    let words = load_inputs(g, axes).expect("checked when the path was made");
-    let sh: &InterpInputs = &words[0];
-    let span = PathSeqInputs {
-        seg_index: index,
-        write_span: true,
-        seg_start: start,
-        seg_length: g.length,
-        ..Default::default()
-    };
-    let shape = PathSeqInputs {
-        seg_index: index,
-        write_shape: true,
-        seg_arc: sh.arc,
-        seg_ccw: sh.ccw,
-        seg_plane_first: sh.plane_first,
-        seg_plane_second: sh.plane_second,
-        seg_centre_first: sh.centre_first,
-        seg_centre_second: sh.centre_second,
-        seg_radius: sh.radius,
-        seg_growth: sh.growth,
-        seg_start_angle: sh.start_angle,
-        seg_rate: sh.rate,
-        ..Default::default()
-    };
-    let mut out = if rng.gen_bool(0.5) {
-        vec![PathSeqInputs {
-            write_span: true,
-            seg_start: start,
-            seg_length: g.length,
-            ..shape
-        }]
-    } else {
-        vec![shape, span]
-    };
-    for w in &words[1..] {
-        out.push(PathSeqInputs {
-            seg_index: index,
-            write_axis: true,
-            seg_axis: w.axis,
-            seg_from: w.from,
-            seg_share: w.share,
-            ..Default::default()
-        });
+    let mut out = segment_writes(index, start, g, axes).expect("checked when the path was made");
+    if rng.gen_bool(0.5) {
+        let both = out[0];
+        out[0].write_span = false;
+        out.insert(
+            1,
+            PathSeqInputs {
+                seg_index: index,
+                write_span: true,
+                seg_start: both.seg_start,
+                seg_length: both.seg_length,
+                ..Default::default()
+            },
+        );
     }
     out
 }

@@ -95,33 +95,6 @@ pub struct PathSteppersReport {
     pub mismatch: Option<PortMismatch>,
 }
 
-/// A sequencer write as the stage's inputs.
-fn as_stage(w: &PathSeqInputs) -> PathSteppersInputs {
-    PathSteppersInputs {
-        seg_index: w.seg_index,
-        write_span: w.write_span,
-        seg_start: w.seg_start,
-        seg_length: w.seg_length,
-        write_shape: w.write_shape,
-        seg_arc: w.seg_arc,
-        seg_ccw: w.seg_ccw,
-        seg_plane_first: w.seg_plane_first,
-        seg_plane_second: w.seg_plane_second,
-        seg_centre_first: w.seg_centre_first,
-        seg_centre_second: w.seg_centre_second,
-        seg_radius: w.seg_radius,
-        seg_growth: w.seg_growth,
-        seg_start_angle: w.seg_start_angle,
-        seg_rate: w.seg_rate,
-        write_axis: w.write_axis,
-        seg_axis: w.seg_axis,
-        seg_from: w.seg_from,
-        seg_share: w.seg_share,
-        extend: w.extend,
-        ..Default::default()
-    }
-}
-
 /// One run: its path and settings, and where it is.
 struct Run {
     path: Path,
@@ -196,11 +169,11 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
                     queue.extend(
                         segment_words(&mut rng, k as u16, start, g, axes)
                             .iter()
-                            .map(as_stage),
+                            .map(PathSteppers::host_inputs),
                     );
                     start += g.length;
                 }
-                queue.push_back(as_stage(&PathSeqInputs {
+                queue.push_back(PathSteppers::host_inputs(&PathSeqInputs {
                     seg_index: segments as u16 - 1,
                     extend: true,
                     ..Default::default()

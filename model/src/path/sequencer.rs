@@ -42,7 +42,8 @@ use snapgen_spec::widths::{
     AXIS_BITS, FRAC_BITS, MAX_AXES, PATH_INDEX_BITS, PATH_SLOTS, RATE_BITS, SHARE_BITS, X_BITS,
 };
 
-use super::engine;
+use super::engine::{self, LoadError};
+use super::interp::Segment;
 use crate::chain::wrap;
 use crate::ports::{InterpInputs, PathSeqInputs, PathSeqOutputs};
 
@@ -224,6 +225,47 @@ pub enum SequencerError {
 /// shorter than this may be `late`.
 pub fn worst_clocks(axes: u8, segments: u64) -> u64 {
     STEP_CLOCKS * (segments + 1) + 1 + u64::from(axes) + engine::clocks(true, axes) + 3
+}
+
+/// The clocks' inputs that write segment `index` of a path, starting at `start` on `s` (raw),
+/// into a sequencer of `axes` axes: its span and shape on one clock, then one axis per clock
+/// (every other input at rest). Refuses a segment the interpolator could not follow
+/// ([`engine::load_inputs`]).
+pub fn segment_writes(
+    index: u16,
+    start: i128,
+    segment: &Segment,
+    axes: u8,
+) -> Result<Vec<PathSeqInputs>, LoadError> {
+    let words = engine::load_inputs(segment, axes)?;
+    let sh = &words[0];
+    let mut out = vec![PathSeqInputs {
+        seg_index: index,
+        write_span: true,
+        seg_start: start,
+        seg_length: segment.length,
+        write_shape: true,
+        seg_arc: sh.arc,
+        seg_ccw: sh.ccw,
+        seg_plane_first: sh.plane_first,
+        seg_plane_second: sh.plane_second,
+        seg_centre_first: sh.centre_first,
+        seg_centre_second: sh.centre_second,
+        seg_radius: sh.radius,
+        seg_growth: sh.growth,
+        seg_start_angle: sh.start_angle,
+        seg_rate: sh.rate,
+        ..Default::default()
+    }];
+    out.extend(words[1..].iter().map(|w| PathSeqInputs {
+        seg_index: index,
+        write_axis: true,
+        seg_axis: w.axis,
+        seg_from: w.from,
+        seg_share: w.share,
+        ..Default::default()
+    }));
+    Ok(out)
 }
 
 /// `a − b` as the fabric forms it over two clocks: the low [`SPLIT`] bits and their borrow
@@ -578,8 +620,8 @@ impl PathSequencer {
 #[cfg(test)]
 mod tests {
     use super::super::cordic::Turn;
-    use super::super::engine::{load_inputs, Engine};
-    use super::super::interp::{Path, Segment, Shape};
+    use super::super::engine::Engine;
+    use super::super::interp::{Path, Shape};
     use super::*;
 
     const ONE: i128 = 1 << 62;
@@ -631,37 +673,8 @@ mod tests {
 
         /// Writes segment `index` (its span and shape, every axis), then extends the path.
         fn append(&mut self, index: u16, start: i128, g: &Segment) {
-            let axes = self.seq.axes;
-            let words = load_inputs(g, axes).expect("loads");
-            self.inputs = PathSeqInputs {
-                seg_index: index,
-                write_span: true,
-                seg_start: start,
-                seg_length: g.length,
-                ..Default::default()
-            };
-            let w = &words[0];
-            self.inputs.write_shape = true;
-            self.inputs.seg_arc = w.arc;
-            self.inputs.seg_ccw = w.ccw;
-            self.inputs.seg_plane_first = w.plane_first;
-            self.inputs.seg_plane_second = w.plane_second;
-            self.inputs.seg_centre_first = w.centre_first;
-            self.inputs.seg_centre_second = w.centre_second;
-            self.inputs.seg_radius = w.radius;
-            self.inputs.seg_growth = w.growth;
-            self.inputs.seg_start_angle = w.start_angle;
-            self.inputs.seg_rate = w.rate;
-            self.clock();
-            for w in &words[1..] {
-                self.inputs = PathSeqInputs {
-                    seg_index: index,
-                    write_axis: true,
-                    seg_axis: w.axis,
-                    seg_from: w.from,
-                    seg_share: w.share,
-                    ..Default::default()
-                };
+            for w in segment_writes(index, start, g, self.seq.axes).expect("loads") {
+                self.inputs = w;
                 self.clock();
             }
             self.inputs.seg_index = index;

@@ -77,6 +77,34 @@ impl PathSteppers {
         (self.position[k] >> FRAC_BITS) as u32
     }
 
+    /// The stage's inputs that carry the sequencer's host-side inputs `w` (its writes and
+    /// extensions; every other input at rest).
+    pub fn host_inputs(w: &PathSeqInputs) -> PathSteppersInputs {
+        PathSteppersInputs {
+            seg_index: w.seg_index,
+            write_span: w.write_span,
+            seg_start: w.seg_start,
+            seg_length: w.seg_length,
+            write_shape: w.write_shape,
+            seg_arc: w.seg_arc,
+            seg_ccw: w.seg_ccw,
+            seg_plane_first: w.seg_plane_first,
+            seg_plane_second: w.seg_plane_second,
+            seg_centre_first: w.seg_centre_first,
+            seg_centre_second: w.seg_centre_second,
+            seg_radius: w.seg_radius,
+            seg_growth: w.seg_growth,
+            seg_start_angle: w.seg_start_angle,
+            seg_rate: w.seg_rate,
+            write_axis: w.write_axis,
+            seg_axis: w.seg_axis,
+            seg_from: w.seg_from,
+            seg_share: w.seg_share,
+            extend: w.extend,
+            ..Default::default()
+        }
+    }
+
     /// The sequencer's inputs of the stage's inputs `i` (the interpolator's `done` from its
     /// outputs after the last clock).
     fn sequencer_inputs(&self, i: &PathSteppersInputs) -> PathSeqInputs {
@@ -174,9 +202,8 @@ impl PathSteppers {
 
 #[cfg(test)]
 mod tests {
-    use super::super::engine::load_inputs;
     use super::super::interp::{Path, Segment, Shape};
-    use super::super::sequencer::worst_clocks;
+    use super::super::sequencer::{segment_writes, worst_clocks};
     use super::*;
 
     const ONE: i128 = 1 << 62;
@@ -186,35 +213,8 @@ mod tests {
     fn load(st: &mut PathSteppers, path: &Path, axes: u8) {
         let mut start = 0;
         for (k, g) in path.segments.iter().enumerate() {
-            let words = load_inputs(g, axes).unwrap();
-            let sh = &words[0];
-            st.clock(&PathSteppersInputs {
-                seg_index: k as u16,
-                write_span: true,
-                seg_start: start,
-                seg_length: g.length,
-                write_shape: true,
-                seg_arc: sh.arc,
-                seg_ccw: sh.ccw,
-                seg_plane_first: sh.plane_first,
-                seg_plane_second: sh.plane_second,
-                seg_centre_first: sh.centre_first,
-                seg_centre_second: sh.centre_second,
-                seg_radius: sh.radius,
-                seg_growth: sh.growth,
-                seg_start_angle: sh.start_angle,
-                seg_rate: sh.rate,
-                ..Default::default()
-            });
-            for w in &words[1..] {
-                st.clock(&PathSteppersInputs {
-                    seg_index: k as u16,
-                    write_axis: true,
-                    seg_axis: w.axis,
-                    seg_from: w.from,
-                    seg_share: w.share,
-                    ..Default::default()
-                });
+            for w in segment_writes(k as u16, start, g, axes).unwrap() {
+                st.clock(&PathSteppers::host_inputs(&w));
             }
             start += g.length;
         }
