@@ -21,11 +21,11 @@
 use rust_hdl::prelude::*;
 use snapgen_model::path::cordic::{constants, ITERATIONS};
 use snapgen_model::path::engine::{Engine, CORDIC_BITS, HI_BITS, LO_BITS, SPLIT, T_BITS};
-use snapgen_model::InterpInputs;
+use snapgen_model::{InterpInputs, InterpOutputs};
 use snapgen_spec::widths::{MAX_AXES, RATE_BITS, RATE_FRAC, SHARE_BITS, SHARE_FRAC};
 
 use crate::block_with_ports;
-use crate::sim_bits::{from_i128, to_i128, to_u128};
+use crate::sim_bits::model_ports;
 use crate::template::{fill, Holes};
 
 /// The block's template.
@@ -49,45 +49,20 @@ impl Interpolator {
     }
 }
 
+snapgen_spec::with_interpolator_ports!(model_ports! { Interpolator, InterpInputs, InterpOutputs; });
+
 impl Logic for Interpolator {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let i = InterpInputs {
-                reset: self.reset.val(),
-                load_shape: self.load_shape.val(),
-                arc: self.arc.val(),
-                ccw: self.ccw.val(),
-                plane_first: self.plane_first.val().to_u64() as u8,
-                plane_second: self.plane_second.val().to_u64() as u8,
-                centre_first: to_i128(self.centre_first.val()),
-                centre_second: to_i128(self.centre_second.val()),
-                radius: to_i128(self.radius.val()),
-                growth: to_i128(self.growth.val()),
-                start_angle: self.start_angle.val().to_u64(),
-                rate: to_u128(self.rate.val()) as i128,
-                load_axis: self.load_axis.val(),
-                axis: self.axis.val().to_u64() as u8,
-                from: to_i128(self.from.val()),
-                share: to_i128(self.share.val()),
-                start: self.start.val(),
-                offset: to_i128(self.offset.val()),
-            };
+            let i = self.model_inputs();
             self._sim.clock(&i);
         }
         let o = self._sim.outputs();
-        self.busy.next = o.busy;
-        self.done.next = o.done;
-        self.out_write.next = o.out_write;
-        self.out_axis.next = u64::from(o.out_axis).into();
-        self.out_value.next = from_i128(o.out_value);
+        self.drive_outputs(&o);
     }
 
     fn connect(&mut self) {
-        self.busy.connect();
-        self.done.connect();
-        self.out_write.connect();
-        self.out_axis.connect();
-        self.out_value.connect();
+        self.connect_outputs();
     }
 
     fn hdl(&self) -> Verilog {

@@ -13,14 +13,14 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::path::sequencer::{PathSequencer as Model, SPLIT};
-use snapgen_model::PathSeqInputs;
+use snapgen_model::{PathSeqInputs, PathSeqOutputs};
 use snapgen_spec::widths::{
     AXIS_BITS, FRAC_BITS, MAX_AXES, PATH_INDEX_BITS, PATH_SLOTS, PATH_SLOT_BITS, RATE_BITS,
     SHARE_BITS, TURN_BITS,
 };
 
 use crate::block_with_ports;
-use crate::sim_bits::{from_i128, to_i128, to_u128};
+use crate::sim_bits::model_ports;
 use crate::template::{fill, Holes};
 
 /// The block's template.
@@ -45,87 +45,22 @@ impl PathSequencerBlock {
     }
 }
 
+snapgen_spec::with_path_sequencer_ports!(
+    model_ports! { PathSequencerBlock, PathSeqInputs, PathSeqOutputs; }
+);
+
 impl Logic for PathSequencerBlock {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let i = PathSeqInputs {
-                reset: self.reset.val(),
-                seg_index: self.seg_index.val().to_u64() as u16,
-                write_span: self.write_span.val(),
-                seg_start: to_i128(self.seg_start.val()),
-                seg_length: to_i128(self.seg_length.val()),
-                write_shape: self.write_shape.val(),
-                seg_arc: self.seg_arc.val(),
-                seg_ccw: self.seg_ccw.val(),
-                seg_plane_first: self.seg_plane_first.val().to_u64() as u8,
-                seg_plane_second: self.seg_plane_second.val().to_u64() as u8,
-                seg_centre_first: to_i128(self.seg_centre_first.val()),
-                seg_centre_second: to_i128(self.seg_centre_second.val()),
-                seg_radius: to_i128(self.seg_radius.val()),
-                seg_growth: to_i128(self.seg_growth.val()),
-                seg_start_angle: self.seg_start_angle.val().to_u64(),
-                seg_rate: to_u128(self.seg_rate.val()) as i128,
-                write_axis: self.write_axis.val(),
-                seg_axis: self.seg_axis.val().to_u64() as u8,
-                seg_from: to_i128(self.seg_from.val()),
-                seg_share: to_i128(self.seg_share.val()),
-                extend: self.extend.val(),
-                tick: self.tick.val(),
-                s: to_i128(self.s.val()),
-                done: self.done.val(),
-            };
+            let i = self.model_inputs();
             self._sim.clock(&i);
         }
         let o = self._sim.outputs();
-        self.load_shape.next = o.load_shape;
-        self.arc.next = o.arc;
-        self.ccw.next = o.ccw;
-        self.plane_first.next = u64::from(o.plane_first).into();
-        self.plane_second.next = u64::from(o.plane_second).into();
-        self.centre_first.next = from_i128(o.centre_first);
-        self.centre_second.next = from_i128(o.centre_second);
-        self.radius.next = from_i128(o.radius);
-        self.growth.next = from_i128(o.growth);
-        self.start_angle.next = o.start_angle.into();
-        self.rate.next = from_i128(o.rate);
-        self.load_axis.next = o.load_axis;
-        self.axis.next = u64::from(o.axis).into();
-        self.from.next = from_i128(o.from);
-        self.share.next = from_i128(o.share);
-        self.start.next = o.start;
-        self.offset.next = from_i128(o.offset);
-        self.commit.next = o.commit;
-        self.segment.next = u64::from(o.segment).into();
-        self.running.next = o.running;
-        self.empty.next = o.empty;
-        self.late.next = o.late;
-        self.refused.next = o.refused;
+        self.drive_outputs(&o);
     }
 
     fn connect(&mut self) {
-        self.load_shape.connect();
-        self.arc.connect();
-        self.ccw.connect();
-        self.plane_first.connect();
-        self.plane_second.connect();
-        self.centre_first.connect();
-        self.centre_second.connect();
-        self.radius.connect();
-        self.growth.connect();
-        self.start_angle.connect();
-        self.rate.connect();
-        self.load_axis.connect();
-        self.axis.connect();
-        self.from.connect();
-        self.share.connect();
-        self.start.connect();
-        self.offset.connect();
-        self.commit.connect();
-        self.segment.connect();
-        self.running.connect();
-        self.empty.connect();
-        self.late.connect();
-        self.refused.connect();
+        self.connect_outputs();
     }
 
     fn hdl(&self) -> Verilog {

@@ -16,12 +16,12 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::path::steppers::PathSteppers as Model;
-use snapgen_model::PathSteppersInputs;
+use snapgen_model::{PathSteppersInputs, PathSteppersOutputs};
 use snapgen_spec::ports::{Dir, Port, INTERPOLATOR, PATH_SEQUENCER, STEP_DIR};
 use snapgen_spec::widths::{AXIS_BITS, FRAC_BITS, MAX_AXES, POSITION_BITS, STEP_TIMER_BITS};
 
 use crate::block_with_ports;
-use crate::sim_bits::{from_u128, to_i128, to_u128};
+use crate::sim_bits::model_ports;
 use crate::template::{fill, Holes};
 
 /// The block's template.
@@ -46,61 +46,22 @@ impl PathSteppersBlock {
     }
 }
 
+snapgen_spec::with_path_steppers_ports!(
+    model_ports! { PathSteppersBlock, PathSteppersInputs, PathSteppersOutputs; }
+);
+
 impl Logic for PathSteppersBlock {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let i = PathSteppersInputs {
-                reset: self.reset.val(),
-                seg_index: self.seg_index.val().to_u64() as u16,
-                write_span: self.write_span.val(),
-                seg_start: to_i128(self.seg_start.val()),
-                seg_length: to_i128(self.seg_length.val()),
-                write_shape: self.write_shape.val(),
-                seg_arc: self.seg_arc.val(),
-                seg_ccw: self.seg_ccw.val(),
-                seg_plane_first: self.seg_plane_first.val().to_u64() as u8,
-                seg_plane_second: self.seg_plane_second.val().to_u64() as u8,
-                seg_centre_first: to_i128(self.seg_centre_first.val()),
-                seg_centre_second: to_i128(self.seg_centre_second.val()),
-                seg_radius: to_i128(self.seg_radius.val()),
-                seg_growth: to_i128(self.seg_growth.val()),
-                seg_start_angle: self.seg_start_angle.val().to_u64(),
-                seg_rate: to_u128(self.seg_rate.val()) as i128,
-                write_axis: self.write_axis.val(),
-                seg_axis: self.seg_axis.val().to_u64() as u8,
-                seg_from: to_i128(self.seg_from.val()),
-                seg_share: to_i128(self.seg_share.val()),
-                extend: self.extend.val(),
-                tick: self.tick.val(),
-                s: to_i128(self.s.val()),
-                step_lsb: to_u128(self.step_lsb.val()),
-                high_clocks: self.high_clocks.val().to_u64() as u16,
-                low_clocks: self.low_clocks.val().to_u64() as u16,
-                setup_clocks: self.setup_clocks.val().to_u64() as u16,
-                enable: self.enable.val().to_u64() as u8,
-            };
+            let i = self.model_inputs();
             self._sim.clock(&i);
         }
         let o = self._sim.outputs();
-        self.segment.next = u64::from(o.segment).into();
-        self.running.next = o.running;
-        self.empty.next = o.empty;
-        self.late.next = o.late;
-        self.refused.next = o.refused;
-        self.step.next = u64::from(o.step).into();
-        self.dir.next = u64::from(o.dir).into();
-        self.overrun.next = from_u128(u128::from(o.overrun));
+        self.drive_outputs(&o);
     }
 
     fn connect(&mut self) {
-        self.segment.connect();
-        self.running.connect();
-        self.empty.connect();
-        self.late.connect();
-        self.refused.connect();
-        self.step.connect();
-        self.dir.connect();
-        self.overrun.connect();
+        self.connect_outputs();
     }
 
     fn hdl(&self) -> Verilog {

@@ -10,9 +10,10 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::io::step_dir::StepDir;
-use snapgen_model::StepDirInputs;
+use snapgen_model::{StepDirInputs, StepDirOutputs};
 
 use crate::block_with_ports;
+use crate::sim_bits::model_ports;
 use crate::template::{fill, Holes};
 
 /// The block's template.
@@ -34,34 +35,22 @@ impl Default for StepDirGenerator {
     }
 }
 
+snapgen_spec::with_step_dir_ports!(
+    model_ports! { StepDirGenerator, StepDirInputs, StepDirOutputs; }
+);
+
 impl Logic for StepDirGenerator {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let i = StepDirInputs {
-                reset: self.reset.val(),
-                step_lsb: self.step_lsb.val().to_u64() as u16,
-                high_clocks: self.high_clocks.val().to_u64() as u16,
-                low_clocks: self.low_clocks.val().to_u64() as u16,
-                setup_clocks: self.setup_clocks.val().to_u64() as u16,
-                enable: self.enable.val(),
-                position: self.position.val().to_u64() as u32,
-            };
+            let i = self.model_inputs();
             self._sim.clock(&i);
         }
         let o = self._sim.outputs();
-        self.step.next = o.step;
-        self.dir.next = o.dir;
-        self.steps.next = u64::from(o.steps).into();
-        self.overrun.next = o.overrun;
-        self.due.next = o.due;
+        self.drive_outputs(&o);
     }
 
     fn connect(&mut self) {
-        self.step.connect();
-        self.dir.connect();
-        self.steps.connect();
-        self.overrun.connect();
-        self.due.connect();
+        self.connect_outputs();
     }
 
     fn hdl(&self) -> Verilog {
