@@ -49,26 +49,9 @@ impl Interpolator {
     }
 }
 
-snapgen_spec::with_interpolator_ports!(model_ports! { Interpolator, InterpInputs, InterpOutputs; });
-
-impl Logic for Interpolator {
-    fn update(&mut self) {
-        if self.clock.pos_edge() {
-            let i = self.model_inputs();
-            self._sim.clock(&i);
-        }
-        let o = self._sim.outputs();
-        self.drive_outputs(&o);
-    }
-
-    fn connect(&mut self) {
-        self.connect_outputs();
-    }
-
-    fn hdl(&self) -> Verilog {
-        Verilog::Custom(interpolator_body(self._axes))
-    }
-}
+snapgen_spec::with_interpolator_ports!(
+    model_ports! { Interpolator, InterpInputs, InterpOutputs, |b| interpolator_body(b._axes); }
+);
 
 /// The arctangent ROM: one `case` entry per CORDIC step.
 fn atan_cases() -> String {

@@ -46,27 +46,8 @@ impl PathSequencerBlock {
 }
 
 snapgen_spec::with_path_sequencer_ports!(
-    model_ports! { PathSequencerBlock, PathSeqInputs, PathSeqOutputs; }
+    model_ports! { PathSequencerBlock, PathSeqInputs, PathSeqOutputs, |b| path_sequencer_body(b._axes); }
 );
-
-impl Logic for PathSequencerBlock {
-    fn update(&mut self) {
-        if self.clock.pos_edge() {
-            let i = self.model_inputs();
-            self._sim.clock(&i);
-        }
-        let o = self._sim.outputs();
-        self.drive_outputs(&o);
-    }
-
-    fn connect(&mut self) {
-        self.connect_outputs();
-    }
-
-    fn hdl(&self) -> Verilog {
-        Verilog::Custom(path_sequencer_body(self._axes))
-    }
-}
 
 /// The block's body for `axes` axes (the template filled, its widths in front).
 fn path_sequencer_body(axes: u8) -> String {

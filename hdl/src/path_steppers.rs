@@ -47,27 +47,8 @@ impl PathSteppersBlock {
 }
 
 snapgen_spec::with_path_steppers_ports!(
-    model_ports! { PathSteppersBlock, PathSteppersInputs, PathSteppersOutputs; }
+    model_ports! { PathSteppersBlock, PathSteppersInputs, PathSteppersOutputs, |b| path_steppers_body(b._axes); }
 );
-
-impl Logic for PathSteppersBlock {
-    fn update(&mut self) {
-        if self.clock.pos_edge() {
-            let i = self.model_inputs();
-            self._sim.clock(&i);
-        }
-        let o = self._sim.outputs();
-        self.drive_outputs(&o);
-    }
-
-    fn connect(&mut self) {
-        self.connect_outputs();
-    }
-
-    fn hdl(&self) -> Verilog {
-        Verilog::Custom(path_steppers_body(self._axes))
-    }
-}
 
 /// `wire [W-1:0] name;` (or a single wire).
 fn wire(name: &str, bits: u32) -> String {

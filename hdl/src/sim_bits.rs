@@ -92,13 +92,14 @@ impl<const N: usize> Drive<i128> for Signal<Out, Bits<N>> {
     }
 }
 
-/// For a block that writes its own Verilog and runs its model in rust-hdl's simulator, from
-/// the spec's port list (called through its `with_*_ports!` macro): `model_inputs` (every
-/// input port into the model's input struct `$ins`), `drive_outputs` (every output port from
-/// the model's output struct) and `connect_outputs`, so that no port is copied by hand.
+/// For a block that writes its own Verilog and runs its model (its field `_sim`) in rust-hdl's
+/// simulator, from the spec's port list (called through its `with_*_ports!` macro): its
+/// `Logic`, whose `update` clocks the model with every input port (into the model's input
+/// struct `$ins`) and drives every output port from its outputs (`$outs`), and whose `hdl` is
+/// the Verilog body `$body` makes of the block, so that no port is copied by hand.
 macro_rules! model_ports {
     (
-        $block:ident, $ins:ident, $outs:ident;
+        $block:ident, $ins:ident, $outs:ident, $body:expr;
         clock: $cdoc:literal;
         inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
         outputs { $( $osec:ident { $( $o:ident : $ok:ident [$ob:expr] $ot:ty, $odoc:literal; )* } )* }
@@ -116,9 +117,25 @@ macro_rules! model_ports {
                 $($( $crate::sim_bits::Drive::<$ot>::drive(&mut self.$o, o.$o); )*)*
             }
 
-            /// Every output port connected.
-            fn connect_outputs(&mut self) {
+        }
+
+        impl Logic for $block {
+            fn update(&mut self) {
+                if self.clock.pos_edge() {
+                    let i = self.model_inputs();
+                    self._sim.clock(&i);
+                }
+                let o = self._sim.outputs();
+                self.drive_outputs(&o);
+            }
+
+            fn connect(&mut self) {
                 $($( self.$o.connect(); )*)*
+            }
+
+            fn hdl(&self) -> Verilog {
+                let body: fn(&$block) -> String = $body;
+                Verilog::Custom(body(self))
             }
         }
     };

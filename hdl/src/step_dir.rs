@@ -36,34 +36,20 @@ impl Default for StepDirGenerator {
 }
 
 snapgen_spec::with_step_dir_ports!(
-    model_ports! { StepDirGenerator, StepDirInputs, StepDirOutputs; }
+    model_ports! { StepDirGenerator, StepDirInputs, StepDirOutputs, |_| step_dir_body(); }
 );
 
-impl Logic for StepDirGenerator {
-    fn update(&mut self) {
-        if self.clock.pos_edge() {
-            let i = self.model_inputs();
-            self._sim.clock(&i);
-        }
-        let o = self._sim.outputs();
-        self.drive_outputs(&o);
-    }
-
-    fn connect(&mut self) {
-        self.connect_outputs();
-    }
-
-    fn hdl(&self) -> Verilog {
-        let body = fill("step_dir.v", TEMPLATE, &Holes::new())
-            .expect("the step/dir template has no holes");
-        Verilog::Custom(crate::protocol_v::with_localparams(
-            &crate::protocol_v::localparams_with(&[
-                ("STEP_TIMER_BITS", snapgen_spec::widths::STEP_TIMER_BITS),
-                ("POSITION_BITS", snapgen_spec::widths::POSITION_BITS),
-            ]),
-            &body,
-        ))
-    }
+/// The generator's body (the template filled, its widths in front).
+fn step_dir_body() -> String {
+    let body =
+        fill("step_dir.v", TEMPLATE, &Holes::new()).expect("the step/dir template has no holes");
+    crate::protocol_v::with_localparams(
+        &crate::protocol_v::localparams_with(&[
+            ("STEP_TIMER_BITS", snapgen_spec::widths::STEP_TIMER_BITS),
+            ("POSITION_BITS", snapgen_spec::widths::POSITION_BITS),
+        ]),
+        &body,
+    )
 }
 
 /// The generator's Verilog: `snapgen_step_dir.v`, top module `snapgen_step_dir`.
