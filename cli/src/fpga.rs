@@ -272,6 +272,9 @@ pub struct BoardSynth {
     /// The path steppers for [`INTERPOLATOR_AXES`] axes (the sequencer, the interpolator and a
     /// step/dir generator per axis), on its own (issue 22: not yet in the board's design).
     pub path_steppers: crate::yosys::SynthReport,
+    /// The path core for [`INTERPOLATOR_AXES`] axes (the motion core on the path length
+    /// driving the path steppers; issue 22: not yet in the board's design).
+    pub path_core: crate::yosys::SynthReport,
     /// The step/dir generator of one axis, on its own (issue 22: not yet in the design).
     pub step_dir: crate::yosys::SynthReport,
 }
@@ -348,7 +351,7 @@ impl BoardSynth {
         format!(
             "Yosys synth_xilinx -family {} for the {} ({}: {}, package {}, speed grade {}):\n\n\
              | design | LUT | FF | CARRY4 | DSP48E1 | LUT-RAM cells | BRAM36 | logic-only path (ns) |\n\
-             |---|---|---|---|---|---|---|---|\n{}{}{}{}{}{}{}\n\
+             |---|---|---|---|---|---|---|---|\n{}{}{}{}{}{}{}{}\n\
              Logic-only path: Yosys `sta` with the Xilinx cell library's specify blocks; routing is\n\
              not included. Motion core budget: ≤ {CORE_LUT_BUDGET} LUT, ≤ {CORE_FF_BUDGET} FF,\n\
              ≤ {CORE_PATH_BUDGET_NS} ns (its program memory is the LUT-RAM, reported apart; its\n\
@@ -395,6 +398,13 @@ impl BoardSynth {
                 ),
                 &self.path_steppers.resources,
                 self.path_steppers.path_ns
+            ),
+            row(
+                &format!(
+                    "path core for {INTERPOLATOR_AXES} axes (motion core on the path length driving the path steppers; no command interface), on its own (issue 22; not yet in the design)"
+                ),
+                &self.path_core.resources,
+                self.path_core.path_ns
             ),
             row(
                 "step/dir generator of one axis, on its own (issue 22; not yet in the design)",
@@ -449,6 +459,14 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
         snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX,
         &b.family,
     )?;
+    let mut files = Vec::new();
+    for (name, text) in snapgen_hdl::path_core::path_core_sources(INTERPOLATOR_AXES) {
+        let file = dir.join(format!("path_core_{name}"));
+        std::fs::write(&file, text).with_context(|| format!("cannot write {}", file.display()))?;
+        files.push(file);
+    }
+    let path_core =
+        crate::yosys::synth(&files, snapgen_hdl::path_core::PATH_CORE_PREFIX, &b.family)?;
     let prefix = snapgen_hdl::step_dir::STEP_DIR_PREFIX;
     let file = dir.join(format!("{prefix}.v"));
     std::fs::write(&file, snapgen_hdl::step_dir::step_dir_verilog())
@@ -462,6 +480,7 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
         interpolator,
         path_sequencer,
         path_steppers,
+        path_core,
         step_dir,
     })
 }

@@ -56,6 +56,11 @@ enum Command {
     /// each axis's position) against its model, every output on every clock, under random
     /// segments from the path planner; exit 1 on any mismatch.
     CosimInterp(cosim_interp::Args),
+    /// Co-simulate the path core (issue 22: the motion core on the path length driving a
+    /// step/dir generator per axis through the path sequencer and the interpolator) against
+    /// its model, every output on every clock, under random paths, moves and group stops;
+    /// exit 1 on any mismatch or a drive's count that breaks the rule.
+    CosimPathCore(cosim_path_core::Args),
     /// Play a timed script of PLCopen commands (MC_MoveAbsolute with its buffer modes,
     /// MC_MoveVelocity, MC_Halt, the feed override) through the host axis on a board: every
     /// change planned from the exact state at a swap tick ahead of the link's latency and
@@ -112,6 +117,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Cosim(a) => cosim::run(a),
         Command::CosimIo(a) => cosim_io::run(a),
         Command::CosimInterp(a) => cosim_interp::run(a),
+        Command::CosimPathCore(a) => cosim_path_core::run(a),
         Command::Online(a) => online::run(a),
         Command::Send(a) => send::run(a),
         Command::Stop(a) => stop::run(a),

@@ -742,3 +742,29 @@ fn path_runs_its_length_on_a_virtual_board() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// `snapgen cosim-path-core` runs the path core in lockstep and reports its runs; a fault
+/// injected into an output exits 1 naming the port and clock.
+#[test]
+fn cosim_path_core_reports_and_fails_on_a_fault() {
+    let out = snapgen(&["cosim-path-core", "--axes", "2", "--clocks", "300000"]);
+    assert_ok(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("300000 clocks compared") && text.contains(", 0 mismatches"),
+        "{text}"
+    );
+    assert!(text.contains("no violation"), "{text}");
+    let out = snapgen(&[
+        "cosim-path-core",
+        "--axes",
+        "2",
+        "--clocks",
+        "300000",
+        "--inject-fault",
+        "12345:step:1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(text.contains("step") && text.contains("12345"), "{text}");
+}

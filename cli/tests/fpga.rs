@@ -270,5 +270,6 @@ fn synth_keeps_the_motion_core_within_budget() {
     assert!(text.contains("| path interpolator for 4 axes"), "{text}");
     assert!(text.contains("| path sequencer for 4 axes"), "{text}");
     assert!(text.contains("| path steppers for 4 axes"), "{text}");
+    assert!(text.contains("| path core for 4 axes"), "{text}");
     assert!(text.contains("| step/dir generator of one axis"), "{text}");
 }

@@ -32,6 +32,7 @@ pub mod input_filter;
 pub mod interpolator;
 pub mod io_top;
 pub mod netlist;
+pub mod path_core;
 pub mod path_sequencer;
 pub mod path_steppers;
 pub mod payload_shift;

@@ -11,8 +11,8 @@
 //! miswired. For rust-hdl's simulator it runs the model. The Verilog is what is checked:
 //! Verilator co-simulation against the model on every clock (`snapgen_sim::path_steppers`).
 //!
-//! Not yet part of a board's design: the chain on the path length and the command interface
-//! that writes the ring are still to be built around it.
+//! The path core (`crate::path_core`) drives it from the motion core's chain; the command
+//! interface that writes the ring is still to be built around both.
 
 use rust_hdl::prelude::*;
 use snapgen_model::path::steppers::PathSteppers as Model;
@@ -51,7 +51,7 @@ snapgen_spec::with_path_steppers_ports!(
 );
 
 /// `wire [W-1:0] name;` (or a single wire).
-fn wire(name: &str, bits: u32) -> String {
+pub(crate) fn wire(name: &str, bits: u32) -> String {
     if bits == 1 {
         format!("wire {name};")
     } else {
@@ -60,7 +60,12 @@ fn wire(name: &str, bits: u32) -> String {
 }
 
 /// An instance of `module` named `name` whose port `p` is connected to `net(p)`.
-fn instance(module: &str, name: &str, ports: &[Port], net: impl Fn(&Port) -> String) -> String {
+pub(crate) fn instance(
+    module: &str,
+    name: &str,
+    ports: &[Port],
+    net: impl Fn(&Port) -> String,
+) -> String {
     let conns: Vec<String> = std::iter::once(".clock(clock)".to_string())
         .chain(ports.iter().map(|p| format!(".{}({})", p.name, net(p))))
         .collect();

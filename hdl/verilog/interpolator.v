@@ -123,10 +123,10 @@ wire [1:0] quarter = theta[63:62] + {1'b0, theta[61]};  // the nearest quarter t
 wire [63:0] z_start = theta - {quarter, 62'd0};
 
 // Begins the product a * b (b's digits: last + 1), for `j`.
-task begin_multiply(input [X_BITS-1:0] a, input [LO_BITS-1:0] b, input [6:0] last, input [1:0] j);
+task begin_multiply(input [X_BITS-1:0] factor_a, input [LO_BITS-1:0] factor_b, input [6:0] last, input [1:0] for_job);
    begin
-      mul_a <= a; mul_b <= b; count <= last; prev <= 1'b0; phase <= 1'b0;
-      hi <= {HI_BITS{1'b0}}; lo <= {LO_BITS{1'b0}}; job <= j; state <= S_MULTIPLY;
+      mul_a <= factor_a; mul_b <= factor_b; count <= last; prev <= 1'b0; phase <= 1'b0;
+      hi <= {HI_BITS{1'b0}}; lo <= {LO_BITS{1'b0}}; job <= for_job; state <= S_MULTIPLY;
    end
 endtask
 

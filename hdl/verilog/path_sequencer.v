@@ -289,7 +289,7 @@ always @(*) begin
    start = start_q;
    offset = offset_q;
    commit = commit_q;
-   segment = k;
+   path_segment = k;
    running = state != S_IDLE;
    empty = is_empty;
    late = late_q;

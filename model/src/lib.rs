@@ -36,8 +36,8 @@ pub use error::{FormatError, ProgramError};
 pub use format::{Format, PositionFix, Quantity, RegisterRange, Widths, DEFAULT_FORMAT, FRAC_BITS};
 pub use ports::{
     CoreCommand, CoreInputs, CoreOutputs, CoreStatus, InterpInputs, InterpOutputs, IoInputs,
-    IoOutputs, PathSeqInputs, PathSeqOutputs, PathSteppersInputs, PathSteppersOutputs,
-    StepDirInputs, StepDirOutputs,
+    IoOutputs, PathCoreInputs, PathCoreOutputs, PathSeqInputs, PathSeqOutputs, PathSteppersInputs,
+    PathSteppersOutputs, StepDirInputs, StepDirOutputs,
 };
 pub use program::{Program, Segment, SnapTimeline};
 

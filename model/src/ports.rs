@@ -15,6 +15,8 @@
 //!   [`crate::path::sequencer`]) for one clock.
 //! * [`PathSteppersInputs`], [`PathSteppersOutputs`]: the path steppers
 //!   (`snapgen_path_steppers`, [`crate::path::steppers`]) for one clock.
+//! * [`PathCoreInputs`], [`PathCoreOutputs`]: the path core (`snapgen_path_core`,
+//!   [`crate::path::core`]) for one clock.
 
 /// A block's inputs and outputs as two structs.
 macro_rules! port_structs {
@@ -53,6 +55,9 @@ snapgen_spec::with_path_sequencer_ports!(port_structs! {
 });
 snapgen_spec::with_path_steppers_ports!(port_structs! {
     PathSteppersInputs, PathSteppersOutputs, "the path steppers";
+});
+snapgen_spec::with_path_core_ports!(port_structs! {
+    PathCoreInputs, PathCoreOutputs, "the path core";
 });
 
 /// The core's `command` inputs and `status` outputs as structs of their own.

@@ -210,6 +210,25 @@ pub fn build_path_steppers_from(verilog: &str, trace: bool) -> Result<Built, Sim
     )
 }
 
+/// Builds (or finds in the cache) the library of the path core for `axes` axes
+/// ([`crate::path_core`]: its file, the motion core's and the path steppers' four).
+pub fn build_path_core(axes: u8, trace: bool) -> Result<Built, SimError> {
+    build_path_core_from(&snapgen_hdl::path_core::path_core_sources_text(axes), trace)
+}
+
+/// Builds the path core's library from the Verilog `verilog` (every source of it: the
+/// generator's, or a deliberately altered copy).
+pub fn build_path_core_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "path-core",
+        snapgen_hdl::path_core::PATH_CORE_PREFIX,
+        verilog,
+        HARNESS_CPP,
+        &crate::path_core::path_core_layout_header(),
+        trace,
+    )
+}
+
 /// Builds (or finds in the cache) the library of the step/dir generator ([`crate::step_dir`]),
 /// with VCD tracing if `trace`.
 pub fn build_step_dir(trace: bool) -> Result<Built, SimError> {

@@ -409,6 +409,85 @@ pub fn harness_header(inputs: &[Port], outputs: &[Port], abi: u32, idle: &[u32])
     s
 }
 
+/// A lockstep's batch: each clock's input words and the model's output words gathered, then
+/// run on the fabric in one call and compared (the lockstep of every block but the core's).
+pub struct Batch {
+    ports: &'static [Port],
+    slots: &'static [Slot],
+    words: usize,
+    fault: Option<PortFault>,
+    /// The clock of the batch's first (from 0).
+    pub first: u64,
+    ins: Vec<u32>,
+    want: Vec<u32>,
+    got: Vec<u32>,
+}
+
+impl Batch {
+    /// An empty batch for the block whose outputs are `ports` at `slots`, `words` words a
+    /// clock, with the test hook `fault` applied to the fabric's words.
+    pub fn new(
+        ports: &'static [Port],
+        slots: &'static [Slot],
+        words: usize,
+        fault: Option<PortFault>,
+    ) -> Self {
+        Batch {
+            ports,
+            slots,
+            words,
+            fault,
+            first: 0,
+            ins: Vec::new(),
+            want: Vec::new(),
+            got: Vec::new(),
+        }
+    }
+
+    /// Adds a clock: its input words and the model's output words after it.
+    pub fn push(&mut self, ins: &[u32], want: &[u32]) {
+        self.ins.extend_from_slice(ins);
+        self.want.extend_from_slice(want);
+    }
+
+    /// Clocks gathered.
+    pub fn len(&self) -> usize {
+        self.want.len() / self.words
+    }
+
+    /// No clock gathered.
+    pub fn is_empty(&self) -> bool {
+        self.want.is_empty()
+    }
+
+    /// Runs the gathered clocks on `fabric` and compares them: the first difference, if
+    /// any. The fabric's words stay readable ([`Batch::got`]) until [`Batch::next`].
+    pub fn run(&mut self, fabric: &mut crate::verilated::Verilated) -> Option<PortMismatch> {
+        fabric.run_each(&self.ins, &mut self.got);
+        if let Some(f) = self.fault {
+            f.apply(self.slots, self.words, self.first, &mut self.got);
+        }
+        if self.got == self.want {
+            return None;
+        }
+        first_difference(
+            self.ports, self.slots, self.words, self.first, &self.got, &self.want,
+        )
+    }
+
+    /// The fabric's words of the batch just run, a clock at a time.
+    pub fn got(&self) -> std::slice::ChunksExact<'_, u32> {
+        self.got.chunks_exact(self.words)
+    }
+
+    /// Begins the next batch after this one.
+    pub fn next(&mut self) {
+        self.first += self.len() as u64;
+        self.ins.clear();
+        self.want.clear();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

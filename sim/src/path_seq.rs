@@ -34,7 +34,7 @@ use snapgen_model::{PathSeqInputs, PathSeqOutputs, FRAC_BITS};
 use snapgen_spec::widths::{MAX_AXES, PATH_SLOTS};
 
 use crate::interp::random_path;
-use crate::layout::{first_difference, harness_header, port_layout};
+use crate::layout::{harness_header, port_layout, Batch};
 pub use crate::layout::{PortFault, PortMismatch};
 use crate::verilated::{abi, Verilated};
 use crate::SimError;
@@ -234,9 +234,8 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
     let mut r = PathSeqReport::default();
     let cell = 1i128 << FRAC_BITS;
     let shortest = worst_clocks(axes, 1);
-    let (mut ins, mut want, mut got) = (Vec::new(), Vec::new(), Vec::new());
+    let mut batch = Batch::new(&PATH_SEQ_OUTPUTS, &OUT_SLOTS, OUT_WORDS, cfg.fault);
     let mut next_pos = vec![0i128; usize::from(axes)];
-    let mut batch_start = 0u64;
     // The stream's state, run by run.
     let mut host: Option<Host> = None;
     let (mut s, mut until_tick, mut period, mut run_ticks) = (0i128, 0u64, shortest, 0u64);
@@ -367,7 +366,7 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
                     probe_given = true;
                     r.probes += 1;
                 } else if h.written < n
-                    && h.written < lowest(k_low, o.segment) + PATH_SLOTS as usize - 1
+                    && h.written < lowest(k_low, o.path_segment) + PATH_SLOTS as usize - 1
                     && rng.gen_bool(0.3)
                 {
                     let k = h.written;
@@ -460,34 +459,18 @@ pub fn run(library: &FsPath, cfg: &PathSeqConfig) -> Result<PathSeqReport, SimEr
             }
         }
         let k_before = seq.reg.k;
-        ins.extend_from_slice(&encode_inputs(&i));
         seq.clock(&i);
         engine.clock(&PathSequencer::interp_inputs(&o, i.reset));
         r.moves += u64::from(seq.reg.k != k_before && !i.reset);
-        want.extend_from_slice(&encode_outputs(&seq.outputs()));
+        batch.push(&encode_inputs(&i), &encode_outputs(&seq.outputs()));
         r.clocks += 1;
-        if want.len() >= BATCH * OUT_WORDS || r.clocks == cfg.clocks {
-            fabric.run_each(&ins, &mut got);
-            if let Some(f) = cfg.fault {
-                f.apply(&OUT_SLOTS, OUT_WORDS, batch_start, &mut got);
+        if batch.len() >= BATCH || r.clocks == cfg.clocks {
+            if let Some(m) = batch.run(&mut fabric) {
+                r.clocks = m.clock + 1;
+                r.mismatch = Some(m);
+                return Ok(r);
             }
-            if got != want {
-                if let Some(m) = first_difference(
-                    &PATH_SEQ_OUTPUTS,
-                    &OUT_SLOTS,
-                    OUT_WORDS,
-                    batch_start,
-                    &got,
-                    &want,
-                ) {
-                    r.clocks = m.clock + 1;
-                    r.mismatch = Some(m);
-                    return Ok(r);
-                }
-            }
-            batch_start = r.clocks;
-            ins.clear();
-            want.clear();
+            batch.next();
         }
     }
     Ok(r)

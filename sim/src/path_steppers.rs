@@ -28,8 +28,9 @@ use snapgen_model::path::sequencer::worst_clocks;
 use snapgen_model::path::steppers::PathSteppers;
 use snapgen_model::{PathSeqInputs, PathSteppersInputs, PathSteppersOutputs, FRAC_BITS};
 
+use crate::drive_lines::{count_error, verdict, Counted, DriveLines, EndFlags, Verdict};
 use crate::interp::random_path;
-use crate::layout::{first_difference, harness_header, port_layout};
+use crate::layout::{harness_header, port_layout, Batch};
 pub use crate::layout::{PortFault, PortMismatch};
 use crate::path_seq::segment_words;
 use crate::verilated::{abi, Verilated};
@@ -120,33 +121,33 @@ struct Run {
     must: u8,
 }
 
+impl Counted for Run {
+    fn counted(&mut self) -> &mut [i64] {
+        &mut self.counted
+    }
+}
+
+/// `x`'s whole output LSBs as the step/dir generator reads them (32 bits, signed).
+fn whole(x: i128) -> i64 {
+    i64::from((x >> FRAC_BITS) as u32 as i32)
+}
+
 /// Runs the stream of `cfg` on the library `library` (built by
 /// [`crate::build::build_path_steppers`] for `cfg.axes` axes).
 pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersReport, SimError> {
     let axes = cfg.axes;
     let n = usize::from(axes);
     let mut fabric = Verilated::open(library, None, PATH_STEPPERS_TAG, IN_WORDS, OUT_WORDS)?;
-    let slot = |name: &str| {
-        PATH_STEPPERS_OUTPUTS
-            .iter()
-            .position(|p| p.name == name)
-            .map(|k| OUT_SLOTS[k])
-            .expect("the spec's path steppers outputs")
-    };
-    let (step_slot, dir_slot) = (slot("step"), slot("dir"));
-    let (overrun_slot, late_slot, refused_slot) = (slot("overrun"), slot("late"), slot("refused"));
+    let mut lines = DriveLines::of(&PATH_STEPPERS_OUTPUTS, &OUT_SLOTS);
     let mut rng = rand::rngs::StdRng::seed_from_u64(cfg.seed);
     let mut model = PathSteppers::new(axes).map_err(|e| SimError::Config(e.to_string()))?;
     let mut r = PathSteppersReport::default();
     let cell = 1i128 << FRAC_BITS;
-    let (mut ins, mut want, mut got) = (Vec::new(), Vec::new(), Vec::new());
-    let mut batch_start = 0u64;
+    let mut batch = Batch::new(&PATH_STEPPERS_OUTPUTS, &OUT_SLOTS, OUT_WORDS, cfg.fault);
     // Each clock of the batch: the run it belongs to is `current` (its counts are updated when
     // the batch is compared), and whether the run ended on it.
     let mut ended: Vec<(u64, Run)> = Vec::new();
     let mut current: Option<Run> = None;
-    let mut lines = (0u8, 0u8);
-    let whole = |x: i128| i64::from((x >> FRAC_BITS) as u32 as i32);
     while r.clocks < cfg.clocks {
         let mut i;
         match current.as_mut() {
@@ -282,9 +283,8 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
                 }
             }
         }
-        ins.extend_from_slice(&encode_inputs(&i));
         model.clock(&i);
-        want.extend_from_slice(&encode_outputs(&model.outputs()));
+        batch.push(&encode_inputs(&i), &encode_outputs(&model.outputs()));
         r.clocks += 1;
         if current
             .as_ref()
@@ -293,58 +293,19 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
             let run = current.take().expect("a run");
             ended.push((r.clocks, run));
         }
-        if want.len() >= BATCH * OUT_WORDS || r.clocks == cfg.clocks {
-            fabric.run_each(&ins, &mut got);
-            if let Some(f) = cfg.fault {
-                f.apply(&OUT_SLOTS, OUT_WORDS, batch_start, &mut got);
-            }
-            if got != want {
-                if let Some(m) = first_difference(
-                    &PATH_STEPPERS_OUTPUTS,
-                    &OUT_SLOTS,
-                    OUT_WORDS,
-                    batch_start,
-                    &got,
-                    &want,
-                ) {
-                    r.clocks = m.clock + 1;
-                    r.mismatch = Some(m);
-                    return Ok(r);
-                }
+        if batch.len() >= BATCH || r.clocks == cfg.clocks {
+            if let Some(m) = batch.run(&mut fabric) {
+                r.clocks = m.clock + 1;
+                r.mismatch = Some(m);
+                return Ok(r);
             }
             // The drives' view of the batch's lines, run by run.
-            let mut runs = ended.drain(..).peekable();
-            for (c, g) in got.chunks(OUT_WORDS).enumerate() {
-                let clock = batch_start + c as u64 + 1;
-                let (step, dir) = (step_slot.get(g) as u8, dir_slot.get(g) as u8);
-                let rising = step & !lines.0;
-                lines = (step, dir);
-                let counts = match runs.peek_mut() {
-                    Some((_, run)) => &mut run.counted,
-                    None => match current.as_mut() {
-                        Some(run) => &mut run.counted,
-                        None => continue,
-                    },
-                };
-                for (k, count) in counts.iter_mut().enumerate() {
-                    if rising >> k & 1 == 1 {
-                        *count += if dir >> k & 1 == 1 { 1 } else { -1 };
-                        r.steps += 1;
-                    }
-                }
-                if runs.peek().is_some_and(|(end, _)| *end == clock) {
-                    let (_, run) = runs.next().expect("peeked");
-                    let flags = (
-                        overrun_slot.get(g) as u8,
-                        late_slot.get(g) == 1,
-                        refused_slot.get(g) == 1,
-                    );
-                    judge(&run, flags, &mut r);
-                }
-            }
-            batch_start = r.clocks;
-            ins.clear();
-            want.clear();
+            let (got, first) = (batch.got(), batch.first);
+            lines.count(got, first, &mut ended, current.as_mut(), |run, flags| {
+                judge(&run, flags, &mut r);
+            });
+            r.steps = lines.steps;
+            batch.next();
         }
     }
     Ok(r)
@@ -352,44 +313,23 @@ pub fn run(library: &FsPath, cfg: &PathSteppersConfig) -> Result<PathSteppersRep
 
 /// The drives' view of a run that ended with the fabric's `overrun`, `late` and `refused`
 /// as `flags` (see the module documentation).
-fn judge(run: &Run, flags: (u8, bool, bool), r: &mut PathSteppersReport) {
-    let (overrun, late, refused) = flags;
+fn judge(run: &Run, flags: EndFlags, r: &mut PathSteppersReport) {
     r.runs += 1;
-    let fail = |r: &mut PathSteppersReport, what: String| {
-        r.violation.get_or_insert(format!("run {}: {what}", r.runs));
-    };
-    if late || refused {
-        fail(r, format!("late {late}, refused {refused}"));
-    }
     if run.must != 0 {
         // Every axis that could not follow says so.
         r.must += 1;
-        r.flagged += u64::from(overrun & run.must == run.must);
+        r.flagged += u64::from(flags.overrun & run.must == run.must);
     }
-    if run.fast {
-        r.fast += 1;
-        return;
-    }
-    if overrun != 0 {
-        fail(r, format!("overrun {overrun:#010b} within the rate"));
-        return;
-    }
-    let end = run.path.at(run.path.length()).expect("a segment");
-    for (k, (&x, (&from, &counted))) in end
-        .iter()
-        .zip(run.start.iter().zip(&run.counted))
-        .enumerate()
-    {
-        let step = i64::from((run.drives.step_lsb >> (16 * k)) as u16);
-        let moved = i64::from((x >> FRAC_BITS) as u32 as i32) - from;
-        if counted != moved.div_euclid(step) {
-            fail(
-                r,
-                format!(
-                    "axis {k}: {counted} steps on the lines, the rule says {moved} LSB / {step}"
-                ),
-            );
+    let end: Vec<i64> = (run.path.at(run.path.length()).expect("a segment").iter())
+        .map(|&x| whole(x))
+        .collect();
+    match verdict(flags, run.fast, || {
+        count_error(&run.counted, &run.start, &end, run.drives.step_lsb)
+    }) {
+        Verdict::Checked => r.checked += 1,
+        Verdict::Fast => r.fast += 1,
+        Verdict::Wrong(what) => {
+            r.violation.get_or_insert(format!("run {}: {what}", r.runs));
         }
     }
-    r.checked += 1;
 }

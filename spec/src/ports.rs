@@ -88,8 +88,8 @@ impl Block {
 /// Calls `$callback! { $($extra)* <the motion core's ports> }` (see the module documentation).
 #[macro_export]
 macro_rules! with_motion_core_ports {
-    ($callback:ident ! { $($extra:tt)* }) => {
-        $callback! { $($extra)*
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $($callback)::+ ! { $($extra)*
             clock: "Fabric clock.";
             inputs {
                 reset {
@@ -317,7 +317,7 @@ macro_rules! with_path_sequencer_ports {
                     commit: bit[1] bool, "The axes the interpolator wrote since the last commit are the positions at the tick before: take them (one clock, on a tick).";
                 }
                 status {
-                    segment: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the sequencer is on.";
+                    path_segment: bits[$crate::widths::PATH_INDEX_BITS] u16, "The segment the sequencer is on.";
                     running: bit[1] bool, "A seek, load or computation runs.";
                     empty: bit[1] bool, "No segment yet (since reset).";
                     late: bit[1] bool, "A tick came while a computation ran (it was dropped and the axes held; sticky until reset).";
@@ -393,6 +393,83 @@ macro_rules! path_steppers_from_sequencer {
     };
 }
 
+/// Calls `$callback! { $($extra)* <the path core's ports> }` (see the module documentation):
+/// the N-axis motion core of a path design for stepper drives (`snapgen_model::path::core`,
+/// issue 22): the motion core, whose chain integrates the path length `s`, driving the path
+/// steppers on each of its ticks. Its ports are the motion core's and the path steppers' (but
+/// the steppers' `tick` and `s`, which the core drives, and their reset, which is the core's);
+/// the steppers' status is the section `path`.
+#[macro_export]
+macro_rules! with_path_core_ports {
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $crate::with_motion_core_ports! {
+            $crate::path_core_from_core! { $($callback)::+ ! { $($extra)* } }
+        }
+    };
+}
+
+/// The path core's list, first step: the motion core's list carried into the path steppers'
+/// (see [`with_path_core_ports!`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! path_core_from_core {
+    (
+        $($callback:ident)::+ ! { $($extra:tt)* }
+        clock: $cdoc:literal;
+        inputs { $($core_in:tt)* }
+        outputs { $($core_out:tt)* }
+    ) => {
+        $crate::with_path_steppers_ports! {
+            $crate::path_core_from_both! {
+                $($callback)::+ ! { $($extra)* }
+                core_inputs { $($core_in)* }
+                core_outputs { $($core_out)* }
+            }
+        }
+    };
+}
+
+/// The path core's list, second step: the motion core's and the path steppers' lists joined
+/// (see [`with_path_core_ports!`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! path_core_from_both {
+    (
+        $($callback:ident)::+ ! { $($extra:tt)* }
+        core_inputs { $($core_in:tt)* }
+        core_outputs { $($core_out:tt)* }
+        clock: $cdoc:literal;
+        inputs {
+            reset { $($reset:tt)* }
+            write { $($write:tt)* }
+            extend { $($extend:tt)* }
+            tick { $($tick:tt)* }
+            drives { $($drives:tt)* }
+        }
+        outputs {
+            status { $($status:tt)* }
+            pins { $($pins:tt)* }
+            drives { $($overrun:tt)* }
+        }
+    ) => {
+        $($callback)::+ ! { $($extra)*
+            clock: $cdoc;
+            inputs {
+                $($core_in)*
+                write { $($write)* }
+                extend { $($extend)* }
+                drives { $($drives)* }
+            }
+            outputs {
+                $($core_out)*
+                path { $($status)* }
+                pins { $($pins)* }
+                drives { $($overrun)* }
+            }
+        }
+    };
+}
+
 /// Calls `$callback! { $($extra)* <the step/dir generator's ports> }` (see the module
 /// documentation): one axis's stepper-drive output, made from its whole-LSB position
 /// (`snapgen_model::io::step_dir`, issue 22).
@@ -462,6 +539,7 @@ with_path_sequencer_ports!(
 with_path_steppers_ports!(
     block_table! { PATH_STEPPERS, "the path steppers (`snapgen_path_steppers`)"; }
 );
+with_path_core_ports!(block_table! { PATH_CORE, "the path core (`snapgen_path_core`)"; });
 
 /// What a board pin is wired to in the board top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -577,6 +655,7 @@ mod tests {
             STEP_DIR,
             PATH_SEQUENCER,
             PATH_STEPPERS,
+            PATH_CORE,
         ] {
             let mut names: Vec<&str> = b.ports.iter().map(|p| p.name).collect();
             names.push(b.clock);
@@ -610,6 +689,36 @@ mod tests {
                 q.name
             );
         }
+    }
+
+    #[test]
+    fn the_path_core_is_the_motion_core_and_the_path_steppers() {
+        // Every motion core port, and every path steppers port but those the core drives
+        // (its tick and path length) and its reset (the core's), once, at the same width.
+        let inner = |p: &&Port| !matches!(p.name, "tick" | "s" | "reset");
+        let expected: Vec<(&str, Dir, u32)> = MOTION_CORE
+            .ports
+            .iter()
+            .chain(
+                PATH_STEPPERS
+                    .ports
+                    .iter()
+                    .filter(|p| p.dir == Dir::Out || inner(p)),
+            )
+            .map(|p| (p.name, p.dir, p.bits))
+            .collect();
+        let got: Vec<(&str, Dir, u32)> = PATH_CORE
+            .ports
+            .iter()
+            .map(|p| (p.name, p.dir, p.bits))
+            .collect();
+        let mut a = expected.clone();
+        let mut b = got.clone();
+        a.sort_by_key(|p| p.0);
+        b.sort_by_key(|p| p.0);
+        assert_eq!(a, b);
+        assert_eq!(PATH_CORE.port("tick").map(|p| p.dir), Some(Dir::Out));
+        assert_eq!(PATH_CORE.section("path").count(), 5);
     }
 
     #[test]

@@ -5,6 +5,7 @@ pub mod build;
 pub mod cosim;
 pub mod cosim_interp;
 pub mod cosim_io;
+pub mod cosim_path_core;
 pub mod demo;
 pub mod experiment;
 pub mod format;

@@ -3,8 +3,10 @@
 //! path interpolator (`snapgen_interpolator.v`) and the path sequencer that drives it
 //! (`snapgen_path_sequencer.v`), with `--step-dir` the step/dir generator
 //! (`snapgen_step_dir.v`), with `--steppers AXES` the N-axis output stage for stepper drives
-//! that instantiates them (`snapgen_path_steppers.v` and the three blocks' files): issue 22's
-//! blocks, not yet in a board's design.
+//! that instantiates them (`snapgen_path_steppers.v` and the three blocks' files), with
+//! `--path-core AXES` the motion core on the path length driving that stage
+//! (`snapgen_path_core.v` with the stage's files): issue 22's blocks, not yet in a board's
+//! design.
 
 use std::path::{Path, PathBuf};
 
@@ -33,6 +35,11 @@ pub struct Args {
     /// in a board's design).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8), conflicts_with_all = ["interpolator", "step_dir"])]
     steppers: Option<u8>,
+    /// Also write the path core for this many axes (1 to 8): the motion core on the path
+    /// length driving the path steppers, `snapgen_path_core.v`, with the steppers' four files
+    /// (it instantiates `snapgen_core`, written anyway; not yet in a board's design).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=8), conflicts_with_all = ["interpolator", "step_dir", "steppers"])]
+    path_core: Option<u8>,
     /// Also write the step/dir generator of one axis as `snapgen_step_dir.v` (a block of its
     /// own: no design instantiates it yet).
     #[arg(long)]
@@ -72,6 +79,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(axes) = a.steppers {
         for (name, text) in snapgen_hdl::path_steppers::path_steppers_sources(axes) {
+            let file = a.out.join(&name);
+            std::fs::write(&file, text)
+                .with_context(|| format!("cannot write {}", file.display()))?;
+            println!("wrote {} ({axes} axes)", file.display());
+        }
+    }
+    if let Some(axes) = a.path_core {
+        for (name, text) in snapgen_hdl::path_core::path_core_sources(axes) {
+            if name == files.core.file_name().unwrap_or_default().to_string_lossy() {
+                continue; // written above
+            }
             let file = a.out.join(&name);
             std::fs::write(&file, text)
                 .with_context(|| format!("cannot write {}", file.display()))?;

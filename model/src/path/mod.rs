@@ -5,10 +5,13 @@
 //! [`cordic`], the integer sine and cosine it uses, [`engine`], the fabric's interpolator
 //! clock by clock, [`sequencer`], the fabric's ring of segments that finds the segment of
 //! each tick's path length and starts the interpolator on it, and [`steppers`], the N-axis
-//! output stage for stepper drives around both. The group stop and the N-axis fabric with the
-//! chain on `s` are not built yet (issue 22).
+//! output stage for stepper drives around both, and [`core`], the motion core whose chain
+//! integrates `s` driving that stage. The group stop along the path (within each segment's
+//! limits), the command interface that writes the ring and the position controllers per axis
+//! are not built yet (issue 22).
 
 pub mod cordic;
+pub mod core;
 pub mod engine;
 pub mod interp;
 pub mod sequencer;

@@ -611,7 +611,7 @@ impl PathSequencer {
         o.axis = r.a_q;
         o.from = r.axis_q.0;
         o.share = r.axis_q.1;
-        o.segment = r.k;
+        o.path_segment = r.k;
         o.running = r.state != State::Idle;
         o.empty = r.last.wrapping_add(1) == r.oldest;
     }

@@ -188,7 +188,7 @@ impl PathSteppers {
                 .fold(0u8, |acc, (k, d)| acc | (u8::from(f(d)) << k))
         };
         self.out = PathSteppersOutputs {
-            segment: so.segment,
+            path_segment: so.path_segment,
             running: so.running,
             empty: so.empty,
             late: so.late,
