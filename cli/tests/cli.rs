@@ -328,10 +328,16 @@ fn demo_runs_and_writes_plots() {
     assert!(stdout.contains("round trip 0 -> 12π -> 0 ends on the start register bit for bit"));
     assert!(stdout.contains(", 0 mismatches"), "{stdout}");
     assert!(stdout.contains(" 0 latches"), "{stdout}");
+    // The G-code part on the Verilated path core: every axis's steps follow the rule.
+    assert!(
+        stdout.contains("path core in fabric:") && stdout.contains(": 0 differ;"),
+        "{stdout}"
+    );
     for f in [
         "seed001_table1.svg",
         "seed001_table3_return.svg",
         "seed000_all_limits.svg",
+        "demo_part_path_core.svg",
     ] {
         assert!(dir.join(f).exists(), "{f} not written");
     }
@@ -741,6 +747,34 @@ fn path_runs_its_length_on_a_virtual_board() {
         "1e-4",
     ]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// `snapgen path --board path-core`: a path longer than the ring the board writes before the
+/// run is refused (exit 2) before anything moves, saying why.
+#[test]
+fn path_core_board_refuses_a_path_longer_than_its_ring() {
+    let long = tmp("ring.ngc");
+    let mut g = String::from("G21 G90 F600\n");
+    for k in 1..=70 {
+        g.push_str(&format!("G1 X{} Y{}\n", k % 2, k));
+    }
+    g.push_str("M30\n");
+    std::fs::write(&long, g).unwrap();
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        long.to_str().unwrap(),
+        "--board",
+        "path-core",
+        "--lsb",
+        "1e-3",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the path has 70 segments") && err.contains("holds 62"),
+        "{err}"
+    );
 }
 
 /// `snapgen cosim-path-core` runs the path core in lockstep and reports its runs; a fault

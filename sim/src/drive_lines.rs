@@ -70,31 +70,43 @@ impl DriveLines {
         let mut runs = ended.drain(..).peekable();
         for (c, g) in got.enumerate() {
             let clock = first + c as u64 + 1;
-            let (step, dir) = (self.step.get(g) as u8, self.dir.get(g) as u8);
-            let rising = step & !self.last;
-            self.last = step;
             let counts = match runs.peek_mut() {
                 Some((_, run)) => run.counted(),
                 None => match current.as_deref_mut() {
                     Some(run) => run.counted(),
-                    None => continue,
+                    None => {
+                        self.last = self.step.get(g) as u8;
+                        continue;
+                    }
                 },
             };
-            for (k, count) in counts.iter_mut().enumerate() {
-                if rising >> k & 1 == 1 {
-                    *count += if dir >> k & 1 == 1 { 1 } else { -1 };
-                    self.steps += 1;
-                }
-            }
+            self.clock(g, counts);
             if runs.peek().is_some_and(|(end, _)| *end == clock) {
                 let (_, run) = runs.next().expect("peeked");
-                let flags = EndFlags {
-                    overrun: self.overrun.get(g) as u8,
-                    late: self.late.get(g) == 1,
-                    refused: self.refused.get(g) == 1,
-                };
-                judge(run, flags);
+                judge(run, self.flags(g));
             }
+        }
+    }
+
+    /// One clock's words `g`: each axis's step that rises on it counted into `counts`.
+    pub fn clock(&mut self, g: &[u32], counts: &mut [i64]) {
+        let (step, dir) = (self.step.get(g) as u8, self.dir.get(g) as u8);
+        let rising = step & !self.last;
+        self.last = step;
+        for (k, count) in counts.iter_mut().enumerate() {
+            if rising >> k & 1 == 1 {
+                *count += if dir >> k & 1 == 1 { 1 } else { -1 };
+                self.steps += 1;
+            }
+        }
+    }
+
+    /// The flags in one clock's words `g`.
+    pub fn flags(&self, g: &[u32]) -> EndFlags {
+        EndFlags {
+            overrun: self.overrun.get(g) as u8,
+            late: self.late.get(g) == 1,
+            refused: self.refused.get(g) == 1,
         }
     }
 }

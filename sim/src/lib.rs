@@ -27,6 +27,7 @@ pub mod io;
 pub mod io_cosim;
 pub mod layout;
 pub mod moves;
+pub mod path_board;
 pub mod path_core;
 pub mod path_seq;
 pub mod path_steppers;

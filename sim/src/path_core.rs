@@ -48,7 +48,7 @@ snapgen_spec::with_path_core_ports!(port_layout! {
 });
 
 /// The path core's tag in the harness's ABI word.
-const PATH_CORE_TAG: u32 = 7;
+pub(crate) const PATH_CORE_TAG: u32 = 7;
 
 /// Clocks the model runs before the fabric runs them in one call.
 const BATCH: usize = 65_536;

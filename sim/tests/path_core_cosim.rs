@@ -71,3 +71,103 @@ fn an_altered_line_of_the_verilog_is_found() {
         assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }
 }
+
+/// The path core as a board's core: a line written into its ring and a move of the path
+/// length played on its chain; each axis's steps on its line follow the rule at the fabric's
+/// path length on every tick, and end on the line's end. With steps too short for the speed
+/// the lines fall behind, and the check says so.
+#[test]
+fn the_board_reads_the_axes_from_its_step_lines() {
+    use snapgen_model::path::interp::{Path, Segment, Shape};
+    use snapgen_model::{ChainState, CoreInputs, Format, FRAC_BITS};
+    use snapgen_plan::{plan_from, Method, MoveRequest};
+    use snapgen_sim::cosim::CoreSide;
+    use snapgen_sim::path_board::PathCoreBoard;
+
+    const ONE: i128 = 1 << 62;
+    let cell = 1i128 << FRAC_BITS;
+    let lib = build_path_core(2, false).expect("the path core builds");
+    let format = Format::with_ts(1e-4);
+    let lsb = format.position_lsb;
+    // 3000 LSB along X and 4000 along Y: 5000 of path.
+    let path = Path {
+        segments: vec![Segment {
+            length: 5000 * cell,
+            shape: Shape::Line {
+                from: vec![0, 0],
+                dir: vec![ONE * 3 / 5, ONE * 4 / 5],
+            },
+        }],
+    };
+    let tick_div = PathCoreBoard::tick_div(2);
+    for (lsb_per_tick, short_steps) in [(300.0, false), (2000.0, true)] {
+        let mut board = PathCoreBoard::open(&lib.library, 2, &format).expect("opens");
+        let home = board.core().chain();
+        let step = if short_steps {
+            1
+        } else {
+            PathCoreBoard::step_for(2, lsb_per_tick).unwrap()
+        };
+        board.load_path(&path, home.x, step).unwrap();
+        let v = lsb_per_tick * lsb / format.ts;
+        let request = MoveRequest {
+            distance: 5001.0 * lsb,
+            method: Method::Order3 {
+                vmax: v,
+                amax: v / format.ts / 10.0,
+                jmax: v / format.ts / format.ts / 50.0,
+            },
+        };
+        let plan = plan_from(&request, &format, ChainState { ..home }).unwrap();
+        let idle = CoreInputs {
+            tick_div,
+            stop_jerk: 1,
+            stop_accel: 1,
+            ..Default::default()
+        };
+        let mut queue: std::collections::VecDeque<CoreInputs> = plan
+            .program
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(k, s)| CoreInputs {
+                write_enable: true,
+                write_address: k as u8,
+                write_ticks: s.ticks,
+                write_snap: s.snap,
+                ..idle
+            })
+            .collect();
+        queue.push_back(CoreInputs {
+            count_enable: true,
+            count_value: plan.program.segments.len() as u8,
+            ..idle
+        });
+        queue.push_back(CoreInputs {
+            start: true,
+            ..idle
+        });
+        let per_tick = u64::from(tick_div) + 1;
+        // The ring goes in and the drives follow, then the move and 10 ticks more.
+        board
+            .run(6 * per_tick, &mut |_| idle)
+            .expect("fabric and model agree");
+        board
+            .run((plan.ticks_total() + 10) * per_tick, &mut |_| {
+                queue.pop_front().unwrap_or(idle)
+            })
+            .expect("fabric and model agree");
+        let view = board.fabric_view();
+        eprintln!("{lsb_per_tick} LSB/tick, step {step}: {view:?}");
+        assert!(view.ticks > plan.ticks_total(), "{view:?}");
+        if short_steps {
+            assert!(view.differing > 0 && view.flags.is_some(), "{view:?}");
+        } else {
+            assert_eq!((view.differing, &view.flags), (0, &None), "{view:?}");
+            // The line's end, by its own numbers: (3000, 4000) LSB, to the step.
+            let s = i64::from(step);
+            assert_eq!(view.end, vec![3000 / s * s, 4000 / s * s], "{view:?}");
+            assert!(view.steps > 0);
+        }
+    }
+}

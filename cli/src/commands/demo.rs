@@ -6,7 +6,9 @@
 //! Then generates the core's Verilog, builds it with Verilator, plays the three moves and a
 //! fourth cut by the fabric's controlled stop on it clock by clock against the model, runs the
 //! I/O top against the device model under random command streams, and prints the mismatch
-//! counts and Yosys' resource counts.
+//! counts and Yosys' resource counts. Then seed 000's Figure 3 online on the fabric, seed
+//! 001's experiment on the closed loop, and a small G-code part on the Verilated path core
+//! (several axes along one path, the interpolator in fabric).
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -280,5 +282,27 @@ pub fn demo(out: &Path) -> anyhow::Result<()> {
             .all(|l| l.profiles.iter().all(|p| p.landed_exactly)),
         "a closed-loop move did not land on its plan"
     );
+
+    // Several axes along one path (issue 22): a small part played by the axis group through
+    // the host axis on the Verilated path core, the interpolator and a step/dir generator per
+    // axis in fabric; the axes read from its step lines.
+    println!("\n== several axes along one path: a small part on the Verilated path core (`snapgen path --gcode examples/demo_part.ngc --board path-core --lsb 1e-3`)");
+    let part = out.join("demo_part.ngc");
+    std::fs::write(&part, DEMO_PART).with_context(|| format!("cannot write {}", part.display()))?;
+    let svg = out.join("demo_part_path_core.svg");
+    let (part, svg) = (part.display().to_string(), svg.display().to_string());
+    super::path::run_args(&[
+        "--gcode",
+        &part,
+        "--board",
+        "path-core",
+        "--lsb",
+        "1e-3",
+        "--svg",
+        &svg,
+    ])?;
     Ok(())
 }
+
+/// The demo's G-code part (`examples/demo_part.ngc`).
+const DEMO_PART: &str = include_str!("../../../examples/demo_part.ngc");

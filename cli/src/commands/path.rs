@@ -9,7 +9,9 @@
 //! or play.
 //!
 //! `--board model|fabric` and `--port` run the path length on a board (its Ts read from it),
-//! the host interpolating. Not built yet (issue 22): corners with a blend, the N-axis fabric.
+//! the host interpolating; `--board path-core` on the Verilated path core, the interpolator in
+//! fabric and the axes read from its step lines. Not built yet (issue 22): corners with a
+//! blend, the command interface that writes the path core's ring.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -20,17 +22,18 @@ use snapgen_host::driver::RunOptions;
 use snapgen_host::gcode::{read, Block};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::PlayError as ScriptError;
-use snapgen_host::path::board::{play_on_board, BoardError};
+use snapgen_host::path::board::{play_on_board_with, BoardError};
 use snapgen_host::path::group::MAX_EVENT_MS;
 use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::Session;
+use snapgen_model::path::interp::Path;
 use snapgen_model::{Format, FRAC_BITS};
 use snapgen_plan::path::speed::Limits;
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
+use snapgen_sim::path_board::{path_core_link, FabricView, PathCoreBoard};
 
-use crate::commands::online::BoardKind;
 use crate::error::{failure, InputError};
 use crate::scenario::seed002_path;
 
@@ -64,15 +67,18 @@ pub struct Args {
     /// Each axis's jerk limit (mm/s³) [G-code: 100000; seed002: 2000000].
     #[arg(long)]
     jmax: Option<f64>,
-    /// The tick (s) [1e-4; on a board, the board's, read from it].
+    /// The tick (s) [1e-4; on a board, the board's, read from it; the path core board is
+    /// built with this tick, 1e-4 by default].
     #[arg(long)]
     ts: Option<f64>,
     /// Run the path length on a virtual board: the device model, or the Verilated I/O top
-    /// with the device model in lockstep (every output compared on every clock); the
-    /// interpolator stays on the host. Without it (or `--port`) the host axis plays its own
-    /// timeline, each change at the tick it is due.
+    /// with the device model in lockstep (every output compared on every clock), the
+    /// interpolator on the host; or the Verilated path core (issue 22: the chain on the path
+    /// length driving the interpolator and a step/dir generator per axis in fabric) with its
+    /// model in lockstep, the axes read from its step lines. Without it (or `--port`) the
+    /// host axis plays its own timeline, each change at the tick it is due.
     #[arg(long, value_enum, conflicts_with = "port")]
-    board: Option<BoardKind>,
+    board: Option<PathBoard>,
     /// A real board's serial port instead.
     #[arg(long)]
     port: Option<String>,
@@ -95,6 +101,19 @@ pub struct Args {
     json: bool,
 }
 
+/// The virtual boards `snapgen path` runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PathBoard {
+    /// The device model.
+    Model,
+    /// The Verilated I/O top, the device model in lockstep (every output compared).
+    Fabric,
+    /// The Verilated path core (the chain, the ring of segments, the interpolator, a
+    /// step/dir generator per axis), its model in lockstep; its command executor the
+    /// model's, the ring written through its ports before the run.
+    PathCore,
+}
+
 /// The path left its program or an axis its limits (exit 1; the report is printed).
 #[derive(Debug, thiserror::Error)]
 #[error("the played path failed its check")]
@@ -114,6 +133,19 @@ fn parse_override(s: &str) -> Result<(f64, f64), String> {
         return Err(bad());
     }
     Ok((k, ms))
+}
+
+/// Runs the subcommand with `args` as its command line would give them (the demo's part).
+pub fn run_args(args: &[&str]) -> anyhow::Result<()> {
+    #[derive(clap::Parser)]
+    struct Line {
+        #[command(flatten)]
+        args: Args,
+    }
+    let line = <Line as clap::Parser>::try_parse_from(
+        std::iter::once("path").chain(args.iter().copied()),
+    )?;
+    run(line.args)
 }
 
 /// Runs the subcommand.
@@ -146,7 +178,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     let on_board = a.board.is_some() || a.port.is_some();
-    if on_board && a.ts.is_some() {
+    if on_board && a.ts.is_some() && a.board != Some(PathBoard::PathCore) {
         return Err(InputError::Board(
             "--ts: a board's tick is read from the board; leave --ts out".into(),
         )
@@ -343,17 +375,50 @@ fn board_run(
     if let Some(port) = &a.port {
         let t = SerialTransport::open(port, a.baud)?;
         let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
-        let (run, format, _) = session_run(link, a.lsb, blocks, axes, own, events)?;
+        let (run, format, _) =
+            session_run(link, a.lsb, blocks, axes, own, events, |_, _, _| Ok(()))?;
         return Ok((run, format, None));
     }
     let design = crate::commands::online::design(a.baud)?;
-    let fabric = a.board == Some(BoardKind::Fabric);
+    if a.board == Some(PathBoard::PathCore) {
+        let axes_n = axes.len() as u8;
+        let format = Format {
+            ts: a.ts.unwrap_or(1e-4),
+            ..design.format
+        };
+        // The step length that follows the fastest axis (its velocity limit).
+        let fastest = axes.iter().map(|l| l.velocity).fold(0.0, f64::max);
+        let step = PathCoreBoard::step_for(axes_n, fastest / a.lsb * format.ts)
+            .map_err(InputError::Board)?;
+        let built = snapgen_sim::build::build_path_core(axes_n, false)?;
+        let mut board = PathCoreBoard::open(&built.library, axes_n, &format)?;
+        let link = path_core_link(&mut board, &format, f64::from(a.baud));
+        let (run, format, _) =
+            session_run(link, a.lsb, blocks, axes, own, events, |s, path, start| {
+                s.link.lockstep().load_path(path, start, step)
+            })?;
+        let view = board.fabric_view();
+        report_view(&view, &run, a.json);
+        if view.differing > 0 || view.flags.is_some() || view.ticks == 0 {
+            return Err(CheckFailed.into());
+        }
+        return Ok((run, format, Some(0)));
+    }
+    let fabric = a.board == Some(PathBoard::Fabric);
     let board = if fabric {
         VirtualBoard::lockstep(&design)?
     } else {
         VirtualBoard::model(&design)
     };
-    let (run, format, link) = session_run(board_link(board), a.lsb, blocks, axes, own, events)?;
+    let (run, format, link) = session_run(
+        board_link(board),
+        a.lsb,
+        blocks,
+        axes,
+        own,
+        events,
+        |_, _, _| Ok(()),
+    )?;
     let b = link.transport().board();
     if let Some(m) = b.first_mismatch() {
         eprintln!("first mismatch: {m:?}");
@@ -361,7 +426,34 @@ fn board_run(
     Ok((run, format, fabric.then(|| b.mismatches())))
 }
 
-/// A session on `link` (the board's format read, the axis at rest), the path played on it.
+/// The path core's axes as its step lines show them (see `snapgen_sim::path_board`).
+fn report_view(v: &FabricView, run: &Run, json: bool) {
+    let out = |line: String| {
+        if json {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
+    };
+    out(format!(
+        "path core in fabric: {} ticks, every axis's steps ({} LSB each) on its line against the rule at the fabric's path length a tick before: {} differ; {} steps",
+        v.ticks, v.step, v.differing, v.steps
+    ));
+    let host: Vec<i64> = run.end_cells().iter().map(|&c| c as i64).collect();
+    out(format!(
+        "  axes at the end from the step lines: {:?} LSB (the host's rule: {:?})",
+        v.end, host
+    ));
+    if let Some(f) = &v.first {
+        out(format!("  first difference: {f}"));
+    }
+    if let Some(f) = &v.flags {
+        out(format!("  FLAGS: {f}"));
+    }
+}
+
+/// A session on `link` (the board's format read, the axis at rest), the path played on it;
+/// `load` gives the board the path before anything moves (a board with the path core).
 fn session_run<L: Link>(
     link: L,
     lsb: f64,
@@ -369,18 +461,23 @@ fn session_run<L: Link>(
     axes: &[Limits],
     own: Option<PathLimits>,
     events: &[PathEvent],
+    load: impl FnOnce(&mut Session<L>, &Path, i128) -> Result<(), String>,
 ) -> anyhow::Result<(Run, Format, L)> {
     let mut session = Session::open(link, lsb).map_err(failure)?;
-    let (run, _, warnings) = play_on_board(
+    let (run, _, warnings) = play_on_board_with(
         &mut session,
         blocks,
         axes,
         own,
         events,
         RunOptions::default(),
+        load,
     )
     .map_err(|e| match e {
         BoardError::Path(p) => InputError::Board(p.to_string()).into(),
+        BoardError::Load(why) => {
+            InputError::Board(format!("giving the board the path: {why}")).into()
+        }
         BoardError::Board(ScriptError::Setup(f)) => failure(f),
         e => anyhow::Error::new(e),
     })?;

@@ -5,10 +5,11 @@
 //! rules. The board's format (its Ts and widths) and its position at rest are read from it
 //! before anything is planned.
 //!
-//! The interpolator runs on the host here: the N-axis fabric (the sequencer and the rules in
-//! the fabric) is not built.
+//! The interpolator runs on the host here; a board with the path core (the interpolator in
+//! its fabric) also takes the path before the run ([`play_on_board_with`]).
 
 use snapgen_model::chain::Trace;
+use snapgen_model::path::interp::Path;
 use snapgen_plan::online::OnlineOrder;
 use snapgen_plan::path::speed::Limits;
 
@@ -33,6 +34,9 @@ pub enum BoardError {
     /// Reading the board's state before the run.
     #[error("reading the board's state: {0}")]
     State(String),
+    /// Giving the board the path before the run.
+    #[error("giving the board the path: {0}")]
+    Load(String),
 }
 
 /// The driver's script for the group's `events`: each element entering is its moves (at the
@@ -76,12 +80,28 @@ pub fn play_on_board<L: Link>(
     events: &[PathEvent],
     run: RunOptions,
 ) -> Result<(Run, RunReport, Vec<String>), BoardError> {
+    play_on_board_with(session, blocks, axes, own, events, run, |_, _, _| Ok(()))
+}
+
+/// [`play_on_board`] on a board that takes the path itself: `load` is given the session, the
+/// whole path (every element the events enter) and the path length register's value where it
+/// starts, once it is known and before anything moves (an error stops the run there).
+pub fn play_on_board_with<L: Link>(
+    session: &mut Session<L>,
+    blocks: &[Block],
+    axes: &[Limits],
+    own: Option<PathLimits>,
+    events: &[PathEvent],
+    run: RunOptions,
+    load: impl FnOnce(&mut Session<L>, &Path, i128) -> Result<(), String>,
+) -> Result<(Run, RunReport, Vec<String>), BoardError> {
     let format = session.format;
     let at = session
         .state()
         .map_err(|e| BoardError::State(e.to_string()))?;
     let mut g = Group::new(blocks, axes, own, &format)?.on_board(at.x)?;
     let (driver_events, first) = script(&mut g, events);
+    load(session, &g.path(), g.start_register()).map_err(BoardError::Load)?;
     let opts = PlayOptions {
         order: OnlineOrder::Three,
         stop_deceleration: None,

@@ -630,12 +630,7 @@ impl<'a> Group<'a> {
     /// Every axis at each path length of `lengths` (raw `s`, the chain's register: from a
     /// board, its position register), through the entered elements' rules.
     pub fn map(&self, lengths: &[i128]) -> Vec<Vec<i128>> {
-        let segments = self
-            .paths
-            .iter()
-            .flat_map(|p| p.segments.iter().cloned())
-            .collect();
-        let path = Path { segments };
+        let path = self.path();
         let origin: Vec<i128> = self.axes.iter().map(|_| raw(0)).collect();
         lengths
             .iter()
@@ -643,10 +638,27 @@ impl<'a> Group<'a> {
             .collect()
     }
 
+    /// The entered elements as one path, its length measured from its start (the rules
+    /// [`Group::map`] applies at [`Group::along`] of a path length register).
+    pub fn path(&self) -> Path {
+        let segments = self
+            .paths
+            .iter()
+            .flat_map(|p| p.segments.iter().cloned())
+            .collect();
+        Path { segments }
+    }
+
+    /// The path length register's value (raw) where the path starts: [`Group::along`] is 0
+    /// there.
+    pub fn start_register(&self) -> i128 {
+        (self.origin_cell << FRAC_BITS) + s0()
+    }
+
     /// How far along the path (raw, from its start's cell centre) a path length register of
     /// `s` is.
     pub fn along(&self, s: i128) -> i128 {
-        s - ((self.origin_cell << FRAC_BITS) + s0())
+        s - self.start_register()
     }
 
     /// The position (units) of `length` units along the path on the path length register.

@@ -48,6 +48,21 @@ macro_rules! core_inputs_of {
     };
 }
 
+/// `PathCore::with_core`: every motion core input, by name, into the path core's.
+macro_rules! with_core_of {
+    (
+        clock: $cdoc:literal;
+        inputs { $( $isec:ident { $( $i:ident : $ik:ident [$ib:expr] $it:ty, $idoc:literal; )* } )* }
+        outputs { $($outs:tt)* }
+    ) => {
+        /// The path core's inputs `rest` with the motion core's inputs of `c` (each by name):
+        /// what a command executor drives, with the path's and the drives' inputs as they are.
+        pub fn with_core(c: &CoreInputs, rest: &PathCoreInputs) -> PathCoreInputs {
+            PathCoreInputs { $($( $i: c.$i, )*)* ..*rest }
+        }
+    };
+}
+
 /// `PathCore::steppers_inputs`: every path steppers input but `tick` and `s`, by name.
 macro_rules! steppers_inputs_of {
     (
@@ -133,6 +148,7 @@ macro_rules! host_inputs_of {
 impl PathCore {
     snapgen_spec::with_path_sequencer_ports!(host_inputs_of! {});
     snapgen_spec::with_motion_core_ports!(core_inputs_of! {});
+    snapgen_spec::with_motion_core_ports!(with_core_of! {});
     snapgen_spec::with_path_steppers_ports!(steppers_inputs_of! {});
     snapgen_spec::with_path_core_ports!(outputs_of! {});
 

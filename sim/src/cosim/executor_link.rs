@@ -24,7 +24,7 @@ use snapgen_model::io::frame_rx::{FrameRx, FrameRxInputs};
 use snapgen_model::io::reply_tx::{status, Live, StatusInputs};
 use snapgen_model::io::servo::ServoOutputs;
 use snapgen_model::timing::Dividers;
-use snapgen_model::{CoreInputs, CoreOutputs, Format};
+use snapgen_model::{CoreInputs, CoreModel, CoreOutputs, Format};
 use snapgen_spec::StateReply;
 
 use super::lockstep::Lockstep;
@@ -90,9 +90,47 @@ impl Board {
     }
 }
 
+/// The core a board's executor drives, in lockstep with its model: the motion core
+/// ([`Lockstep`]) or a design around it (the path core's, `crate::path_core`).
+pub trait CoreSide {
+    /// A lockstep's first difference.
+    type Mismatch: std::fmt::Display;
+    /// `n` clocks, each with the core's inputs that `source` gives from the core model's
+    /// outputs before it, compared.
+    fn run(
+        &mut self,
+        n: u64,
+        source: &mut dyn FnMut(&CoreOutputs) -> CoreInputs,
+    ) -> Result<(), Self::Mismatch>;
+    /// The core's model.
+    fn core(&self) -> &CoreModel;
+    /// Clocks run.
+    fn clocks(&self) -> u64;
+}
+
+impl CoreSide for Lockstep {
+    type Mismatch = Mismatch;
+
+    fn run(
+        &mut self,
+        n: u64,
+        source: &mut dyn FnMut(&CoreOutputs) -> CoreInputs,
+    ) -> Result<(), Mismatch> {
+        Lockstep::run(self, n, source)
+    }
+
+    fn core(&self) -> &CoreModel {
+        &self.side.model
+    }
+
+    fn clocks(&self) -> u64 {
+        self.clock
+    }
+}
+
 /// A link to the lockstep core through the board's executor (module documentation).
-pub struct ExecutorLink<'l> {
-    ls: &'l mut Lockstep,
+pub struct ExecutorLink<'l, S: CoreSide = Lockstep> {
+    ls: &'l mut S,
     board: Board,
     design: Design,
     /// The format commands are encoded with (set after PING).
@@ -105,16 +143,16 @@ pub struct ExecutorLink<'l> {
     /// Wire time not yet passed on the core (clocks, a fraction of one).
     owed: f64,
     /// The first mismatch: every request fails after it.
-    mismatch: Option<Mismatch>,
+    mismatch: Option<S::Mismatch>,
     telemetry: Option<Status>,
 }
 
-impl<'l> ExecutorLink<'l> {
+impl<'l, S: CoreSide> ExecutorLink<'l, S> {
     /// A link at `baud` to a board whose core is `ls`, ticking every `tick_div + 1` clocks of
     /// `ts` each and planning in `format`: the executor reset (its configuration at the
     /// design's defaults, the axis Disabled), the encoder reading the cell the core stands
     /// in (POWER 1 loads the reference where it is).
-    pub fn new(ls: &'l mut Lockstep, format: &Format, tick_div: u32, baud: f64) -> Self {
+    pub fn new(ls: &'l mut S, format: &Format, tick_div: u32, baud: f64) -> Self {
         let clock_hz = (f64::from(tick_div) + 1.0) / format.ts;
         let design = Design {
             format: *format,
@@ -131,7 +169,7 @@ impl<'l> ExecutorLink<'l> {
             design_hash: 0,
             input_polarity: 0,
         };
-        let encoder = (ls.side.model.chain().x >> snapgen_model::FRAC_BITS) as u32;
+        let encoder = (ls.core().chain().x >> snapgen_model::FRAC_BITS) as u32;
         let d = design.dividers;
         ExecutorLink {
             ls,
@@ -155,7 +193,7 @@ impl<'l> ExecutorLink<'l> {
     }
 
     /// The lockstep (for what the stream does after the link).
-    pub fn lockstep(&mut self) -> &mut Lockstep {
+    pub fn lockstep(&mut self) -> &mut S {
         self.ls
     }
 
@@ -165,7 +203,7 @@ impl<'l> ExecutorLink<'l> {
     }
 
     /// The first mismatch the link met, taken.
-    pub fn take_mismatch(&mut self) -> Option<Mismatch> {
+    pub fn take_mismatch(&mut self) -> Option<S::Mismatch> {
         self.mismatch.take()
     }
 
@@ -194,7 +232,7 @@ impl<'l> ExecutorLink<'l> {
     /// The values a reply is read from, now.
     fn live(&self) -> Live {
         let exec = self.board.exec.outputs();
-        let core = self.ls.side.model.outputs();
+        let core = self.ls.core().outputs();
         Live {
             status: status(&StatusInputs {
                 exec: &exec,
@@ -229,7 +267,7 @@ impl<'l> ExecutorLink<'l> {
     }
 }
 
-impl Link for ExecutorLink<'_> {
+impl<S: CoreSide> Link for ExecutorLink<'_, S> {
     fn ask(&mut self, c: &Command) -> Result<Reply, LinkError> {
         self.failed()?;
         self.seq = self.seq.wrapping_add(1).max(1);
@@ -286,7 +324,7 @@ impl Link for ExecutorLink<'_> {
     }
 
     fn now(&self) -> f64 {
-        (self.ls.clock as f64 + self.owed) / f64::from(self.design.clock_hz)
+        (self.ls.clocks() as f64 + self.owed) / f64::from(self.design.clock_hz)
     }
 
     fn wait(&mut self, seconds: f64) {

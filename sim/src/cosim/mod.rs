@@ -24,6 +24,7 @@ mod report;
 mod streams;
 
 pub use compare::{Fault, Mismatch, Register};
+pub use executor_link::{CoreSide, ExecutorLink};
 pub use lockstep::{Lockstep, ModelSide, BATCH};
 pub use report::CosimReport;
 
