@@ -20,6 +20,13 @@
 //! Anything else — another G or M code, a word such as `S`, `T`, `A` — is refused with its
 //! line, as is a feed move before any `F`, an arc whose centre or radius does not fit its end
 //! point, or a program without an end. The machine starts at 0 on every axis.
+//!
+//! **Arcs from CAM.** A CAM post rounds an arc's end point and centre to its decimals, so the
+//! end rarely lies on the circle through the start: an end up to the tolerance
+//! ([`DEFAULT_ARC_TOLERANCE_MM`], `--arc-tolerance`) nearer or farther than the start has its
+//! centre corrected onto the chord's perpendicular bisector (as TwinCAT's centre-point
+//! correction does), and the path is the circle through both points; farther off, the block
+//! is refused.
 
 use g_code::emit::{Field, Value};
 use g_code::parse::ast::Spanned;
@@ -93,6 +100,12 @@ pub enum GcodeError {
         /// The reach (mm).
         limit: f64,
     },
+    /// A tolerance that is not a number ≥ 0.
+    #[error("--arc-tolerance {value}: give a number of mm ≥ 0")]
+    Tolerance {
+        /// The value.
+        value: f64,
+    },
     /// A program that does not end with M2 or M30.
     #[error("the program has no end: finish it with M2 or M30")]
     NoEnd,
@@ -118,8 +131,29 @@ fn number(f: &Field) -> Option<f64> {
     }
 }
 
-/// Reads `src` into motion blocks on a grid of `lsb` mm (module documentation).
+/// The default tolerance on an arc's radii (mm): its end may lie this much nearer to or
+/// farther from its centre than its start (CAM output rounds both to its decimals); the
+/// centre is then corrected ([`read_with`]). TwinCAT CNC's default for the same check is 5 µm.
+pub const DEFAULT_ARC_TOLERANCE_MM: f64 = 0.005;
+
+/// Reads `src` into motion blocks on a grid of `lsb` mm (module documentation), arcs within
+/// [`DEFAULT_ARC_TOLERANCE_MM`].
 pub fn read(src: &str, lsb: f64) -> Result<Vec<Block>, GcodeError> {
+    read_with(src, lsb, DEFAULT_ARC_TOLERANCE_MM)
+}
+
+/// Reads `src` into motion blocks on a grid of `lsb` mm (module documentation). An arc whose
+/// end is up to `arc_tolerance` mm nearer to or farther from its centre than its start (but
+/// more than an LSB) has its centre moved onto the chord's perpendicular bisector, to the grid
+/// point nearest to where its programmed centre projects whose radii differ by at most an LSB
+/// (the path is then that circle through both points, swept the same way); beyond the
+/// tolerance it is refused with its line.
+pub fn read_with(src: &str, lsb: f64, arc_tolerance: f64) -> Result<Vec<Block>, GcodeError> {
+    if !(arc_tolerance.is_finite() && arc_tolerance >= 0.0) {
+        return Err(GcodeError::Tolerance {
+            value: arc_tolerance,
+        });
+    }
     let file = g_code::parse::file_parser(src).map_err(|e| GcodeError::Parse {
         line: e.location.line,
         column: e.location.column,
@@ -222,7 +256,7 @@ pub fn read(src: &str, lsb: f64) -> Result<Vec<Block>, GcodeError> {
             };
             let element = match m.motion {
                 0 | 1 => Element::Line { to: to.to_vec() },
-                _ => arc(line, &m, at, to, lsb, |c| word(c).map(cells))?,
+                _ => arc(line, &m, at, to, lsb, arc_tolerance, |c| word(c).map(cells))?,
             };
             if to != at || !matches!(element, Element::Line { .. }) {
                 blocks.push(Block {
@@ -247,6 +281,7 @@ fn arc(
     at: [i64; 3],
     to: [i64; 3],
     lsb: f64,
+    tolerance: f64,
     word: impl Fn(char) -> Option<i64>,
 ) -> Result<Element, GcodeError> {
     let [p, q] = m.plane;
@@ -313,12 +348,65 @@ fn arc(
             centre[1] as f64 * lsb
         )));
     }
+    let centre = corrected_centre([at[p], at[q]], [to[p], to[q]], centre, tolerance / lsb)
+        .map_err(|(rs, re)| {
+            bad(format!(
+                "the arc's end is {} mm from its centre, its start {} mm: they differ by more than the tolerance of {tolerance} mm (--arc-tolerance)",
+                re * lsb,
+                rs * lsb
+            ))
+        })?;
     Ok(Element::Arc {
         plane: m.plane,
         centre,
         ccw,
         to: to.to_vec(),
     })
+}
+
+/// Each point's distance from `c` (LSB), as the path's preparation measures it.
+fn radii(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> (f64, f64) {
+    let r = |v: [i64; 2]| ((v[0] - c[0]) as f64).hypot((v[1] - c[1]) as f64);
+    (r(a), r(b))
+}
+
+/// The centre of an arc from `a` to `b` (in its plane, LSB) programmed at `c`: `c` when the
+/// two radii differ by at most an LSB; when they differ by at most `tolerance` LSB, the grid
+/// point nearest to `c`'s projection on the chord's perpendicular bisector whose radii differ
+/// by at most an LSB (the projection keeps `c`'s side of the chord, so the arc turns the same
+/// way over about the same sweep); otherwise both radii, as the error.
+fn corrected_centre(
+    a: [i64; 2],
+    b: [i64; 2],
+    c: [i64; 2],
+    tolerance: f64,
+) -> Result<[i64; 2], (f64, f64)> {
+    let (rs, re) = radii(a, b, c);
+    if (rs - re).abs() <= 1.0 {
+        return Ok(c);
+    }
+    if (rs - re).abs() > tolerance.max(1.0) {
+        return Err((rs, re));
+    }
+    // The chord's midpoint and direction; c projected along the chord onto its bisector.
+    let (mx, my) = ((a[0] + b[0]) as f64 / 2.0, (a[1] + b[1]) as f64 / 2.0);
+    let (dx, dy) = ((b[0] - a[0]) as f64, (b[1] - a[1]) as f64);
+    let chord = dx.hypot(dy);
+    let (ux, uy) = (dx / chord, dy / chord);
+    let along = (c[0] as f64 - mx) * ux + (c[1] as f64 - my) * uy;
+    let (px, py) = (c[0] as f64 - along * ux, c[1] as f64 - along * uy);
+    let mut best: Option<([i64; 2], f64)> = None;
+    for ox in -2..=2 {
+        for oy in -2..=2 {
+            let g = [px.round() as i64 + ox, py.round() as i64 + oy];
+            let (s, e) = radii(a, b, g);
+            let d = (g[0] as f64 - px).hypot(g[1] as f64 - py);
+            if (s - e).abs() <= 1.0 && best.is_none_or(|(_, bd)| d < bd) {
+                best = Some((g, d));
+            }
+        }
+    }
+    best.map(|(g, _)| g).ok_or((rs, re))
 }
 
 #[cfg(test)]
@@ -431,5 +519,36 @@ mod tests {
             let e = read(src, NM).unwrap_err().to_string();
             assert!(e.contains(want), "{src:?}: {e}");
         }
+    }
+
+    /// A CAM arc rounded to its 3 decimals: its end 1 µm (1000 LSB) farther from the
+    /// programmed centre than its start. Within the tolerance its centre is moved onto the
+    /// chord's bisector, on the same side: both radii then agree within an LSB, and the
+    /// centre moved no more than the rounding needs. Beyond it (or with a tolerance of 0)
+    /// the block is refused with its line and both radii.
+    #[test]
+    fn a_cam_arc_within_the_tolerance_has_its_centre_corrected() {
+        let src = "G21 F600\nG1 X10\nG3 X0 Y10.001 I-10 J0\nM2\n";
+        let b = read(src, NM).unwrap();
+        let Element::Arc { centre, to, .. } = &b[1].element else {
+            panic!("an arc")
+        };
+        let (rs, re) = radii([10_000_000, 0], [to[0], to[1]], *centre);
+        assert!((rs - re).abs() <= 1.0, "{rs} {re}");
+        // On the bisector of (10, 0)–(0, 10.001) near (0, 0): x ≈ y − 0.001 mm or so.
+        let shift = (centre[0] as f64).hypot(centre[1] as f64) * NM;
+        assert!(shift < 0.001, "moved {shift} mm: {centre:?}");
+        assert!(centre[0] != 0 || centre[1] != 0, "moved");
+        for (tol, src) in [
+            (0.005, "G21 F600\nG1 X10\nG3 X0 Y10.01 I-10 J0\nM2\n"),
+            (0.0, src),
+        ] {
+            let e = read_with(src, NM, tol).unwrap_err().to_string();
+            assert!(
+                e.contains("line 3: the arc's end is") && e.contains("more than the tolerance of"),
+                "{e}"
+            );
+        }
+        assert!(read_with(src, NM, -1.0).is_err());
     }
 }

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use snapgen_host::driver::RunOptions;
-use snapgen_host::gcode::{read, Block};
+use snapgen_host::gcode::{read_with, Block, DEFAULT_ARC_TOLERANCE_MM};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::PlayError as ScriptError;
 use snapgen_host::path::board::{play_on_board_with, BoardError};
@@ -88,6 +88,11 @@ pub struct Args {
     /// The output grid (mm per LSB).
     #[arg(long, default_value_t = 1e-6)]
     lsb: f64,
+    /// How much nearer to or farther from its centre an arc's end may be than its start (mm):
+    /// within it the centre is corrected onto the chord's bisector (CAM output rounds both
+    /// to its decimals); beyond it the block is refused.
+    #[arg(long, default_value_t = DEFAULT_ARC_TOLERANCE_MM)]
+    arc_tolerance: f64,
     /// Write the per-tick trace (tick, time, X, Y, Z in mm) to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -194,7 +199,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some(file) => {
             let src = std::fs::read_to_string(file)
                 .with_context(|| format!("cannot read {}", file.display()))?;
-            let blocks = read(&src, a.lsb)
+            let blocks = read_with(&src, a.lsb, a.arc_tolerance)
                 .map_err(|e| InputError::Board(format!("{}: {e}", file.display())))?;
             let mut events: Vec<PathEvent> = a
                 .overrides

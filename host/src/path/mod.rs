@@ -317,6 +317,23 @@ mod tests {
         jerk: 100_000.0,
     };
 
+    /// A CAM arc whose end is 1 µm off its circle (its centre corrected by the reader) is
+    /// played on the path (the circle through both points) within every limit.
+    #[test]
+    fn a_cam_arc_is_played_on_its_corrected_circle() {
+        let src = "G21 G90 F1200\nG1 X10\nG3 X0 Y10.001 I-10 J0\nG1 X-5\nM30\n";
+        let lsb = 1e-6;
+        let f = Format {
+            position_lsb: lsb,
+            ..F
+        };
+        let blocks = read(src, lsb).unwrap();
+        let run = play(&blocks, &[AXIS; 3], &f).unwrap();
+        let c = verify(&run, &blocks, &[AXIS; 3], &f);
+        assert!(c.deviation.is_none() && c.exceeded.is_none(), "{c:?}");
+        assert_eq!(run.end_cells(), vec![-5_000_000, 10_001_000, 0]);
+    }
+
     #[test]
     fn a_small_part_stays_on_its_path_within_every_limit() {
         let src =
