@@ -750,7 +750,8 @@ fn path_runs_its_length_on_a_virtual_board() {
 }
 
 /// `snapgen path --board path-core`: a path longer than the ring the board writes before the
-/// run is refused (exit 2) before anything moves, saying why.
+/// run, or with elements too short for its tick, is refused (exit 2) before anything moves,
+/// saying why.
 #[test]
 fn path_core_board_refuses_a_path_longer_than_its_ring() {
     let long = tmp("ring.ngc");
@@ -773,6 +774,29 @@ fn path_core_board_refuses_a_path_longer_than_its_ring() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("the path has 70 segments") && err.contains("holds 62"),
+        "{err}"
+    );
+    // Three elements shorter together than a tick's advance: a tick could cross more
+    // segments than the board's tick has room for.
+    let short = tmp("short.ngc");
+    std::fs::write(
+        &short,
+        "G21 G90 F600\nG1 X0.001\nG1 X0.002\nG1 X0.003\nG1 X5\nM30\n",
+    )
+    .unwrap();
+    let out = snapgen(&[
+        "path",
+        "--gcode",
+        short.to_str().unwrap(),
+        "--board",
+        "path-core",
+        "--lsb",
+        "1e-3",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("segments 0 to 2 are 3.0 LSB long together"),
         "{err}"
     );
 }

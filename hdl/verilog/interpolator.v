@@ -122,7 +122,7 @@ wire [63:0] turned = {hi[63-(RATE_BITS-RATE_FRAC):0], lo[LO_BITS-1:RATE_FRAC]};
 wire [1:0] quarter = theta[63:62] + {1'b0, theta[61]};  // the nearest quarter turn: (theta + 2^61) >> 62
 wire [63:0] z_start = theta - {quarter, 62'd0};
 
-// Begins the product a * b (b's digits: last + 1), for `j`.
+// Begins the product factor_a * factor_b (factor_b's digits: last + 1), for the job `for_job`.
 task begin_multiply(input [X_BITS-1:0] factor_a, input [LO_BITS-1:0] factor_b, input [6:0] last, input [1:0] for_job);
    begin
       mul_a <= factor_a; mul_b <= factor_b; count <= last; prev <= 1'b0; phase <= 1'b0;

@@ -348,14 +348,8 @@ fn arc(
             centre[1] as f64 * lsb
         )));
     }
-    let centre = corrected_centre([at[p], at[q]], [to[p], to[q]], centre, tolerance / lsb)
-        .map_err(|(rs, re)| {
-            bad(format!(
-                "the arc's end is {} mm from its centre, its start {} mm: they differ by more than the tolerance of {tolerance} mm (--arc-tolerance)",
-                re * lsb,
-                rs * lsb
-            ))
-        })?;
+    let centre = corrected_centre([at[p], at[q]], [to[p], to[q]], centre, tolerance / lsb, lsb)
+        .map_err(bad)?;
     Ok(Element::Arc {
         plane: m.plane,
         centre,
@@ -372,21 +366,32 @@ fn radii(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> (f64, f64) {
 
 /// The centre of an arc from `a` to `b` (in its plane, LSB) programmed at `c`: `c` when the
 /// two radii differ by at most an LSB; when they differ by at most `tolerance` LSB, the grid
-/// point nearest to `c`'s projection on the chord's perpendicular bisector whose radii differ
-/// by at most an LSB (the projection keeps `c`'s side of the chord, so the arc turns the same
-/// way over about the same sweep); otherwise both radii, as the error.
+/// point nearest to `c`'s projection on the chord's perpendicular bisector, on `c`'s side of
+/// the chord, whose radii differ by at most an LSB, provided it lies within `tolerance` of `c`
+/// (a short chord would move the centre far: refused). Otherwise why not (`lsb` mm an LSB,
+/// for the message).
 fn corrected_centre(
     a: [i64; 2],
     b: [i64; 2],
     c: [i64; 2],
     tolerance: f64,
-) -> Result<[i64; 2], (f64, f64)> {
+    lsb: f64,
+) -> Result<[i64; 2], String> {
     let (rs, re) = radii(a, b, c);
     if (rs - re).abs() <= 1.0 {
         return Ok(c);
     }
+    let mm = |x: f64| x * lsb;
+    let radii_text = format!(
+        "the arc's end is {} mm from its centre, its start {} mm",
+        mm(re),
+        mm(rs)
+    );
     if (rs - re).abs() > tolerance.max(1.0) {
-        return Err((rs, re));
+        return Err(format!(
+            "{radii_text}: they differ by more than the tolerance of {} mm (--arc-tolerance)",
+            mm(tolerance)
+        ));
     }
     // The chord's midpoint and direction; c projected along the chord onto its bisector.
     let (mx, my) = ((a[0] + b[0]) as f64 / 2.0, (a[1] + b[1]) as f64 / 2.0);
@@ -395,18 +400,37 @@ fn corrected_centre(
     let (ux, uy) = (dx / chord, dy / chord);
     let along = (c[0] as f64 - mx) * ux + (c[1] as f64 - my) * uy;
     let (px, py) = (c[0] as f64 - along * ux, c[1] as f64 - along * uy);
+    // The side of the chord a centre lies on (the sign of the cross product).
+    let side = |g: [i64; 2]| {
+        (i128::from(b[0] - a[0]) * i128::from(g[1] - a[1])
+            - i128::from(b[1] - a[1]) * i128::from(g[0] - a[0]))
+        .signum()
+    };
     let mut best: Option<([i64; 2], f64)> = None;
     for ox in -2..=2 {
         for oy in -2..=2 {
             let g = [px.round() as i64 + ox, py.round() as i64 + oy];
             let (s, e) = radii(a, b, g);
             let d = (g[0] as f64 - px).hypot(g[1] as f64 - py);
-            if (s - e).abs() <= 1.0 && best.is_none_or(|(_, bd)| d < bd) {
+            if (s - e).abs() <= 1.0 && side(g) == side(c) && best.is_none_or(|(_, bd)| d < bd) {
                 best = Some((g, d));
             }
         }
     }
-    best.map(|(g, _)| g).ok_or((rs, re))
+    let Some((g, _)) = best else {
+        return Err(format!(
+            "{radii_text}, and no centre on the grid near the chord's bisector fits both"
+        ));
+    };
+    let moved = ((g[0] - c[0]) as f64).hypot((g[1] - c[1]) as f64);
+    if moved > tolerance.max(1.0) + 1.0 {
+        return Err(format!(
+            "{radii_text}: fitting both moves the centre {} mm, more than the tolerance of {} mm (--arc-tolerance; a short chord moves it far)",
+            mm(moved),
+            mm(tolerance)
+        ));
+    }
+    Ok(g)
 }
 
 #[cfg(test)]
@@ -542,6 +566,9 @@ mod tests {
         for (tol, src) in [
             (0.005, "G21 F600\nG1 X10\nG3 X0 Y10.01 I-10 J0\nM2\n"),
             (0.0, src),
+            // Nearly a full turn, its end 1 µm out: fitting both would move the centre to the
+            // chord's midpoint, 10 mm away (a half turn of 0.5 µm instead of a circle).
+            (0.005, "G21 F600\nG1 X10\nG3 X10.001 Y0 I-10 J0\nM2\n"),
         ] {
             let e = read_with(src, NM, tol).unwrap_err().to_string();
             assert!(

@@ -2,7 +2,14 @@
 //! step line's rising edges, signed by its direction line, run by run (the lockstep of every
 //! stage with step/dir outputs).
 
-use crate::layout::{Port, Slot};
+use snapgen_model::FRAC_BITS;
+
+use crate::layout::{slot_named, Port, Slot};
+
+/// `x`'s whole output LSBs as a step/dir generator reads them (32 bits, signed).
+pub fn whole(x: i128) -> i64 {
+    i64::from((x >> FRAC_BITS) as u32 as i32)
+}
 
 /// Where a run keeps each axis's steps counted on the lines.
 pub trait Counted {
@@ -38,13 +45,7 @@ impl DriveLines {
     /// The view of a stage whose outputs are `ports` at `slots`, among them the vectors
     /// `step`, `dir` and `overrun` (axis k: bit k) and the flags `late` and `refused`.
     pub fn of(ports: &[Port], slots: &[Slot]) -> Self {
-        let slot = |name: &str| {
-            ports
-                .iter()
-                .position(|p| p.name == name)
-                .map(|k| slots[k])
-                .unwrap_or_else(|| panic!("the stage has no output {name}"))
-        };
+        let slot = |name: &str| slot_named(ports, slots, name);
         DriveLines {
             step: slot("step"),
             dir: slot("dir"),
@@ -56,7 +57,8 @@ impl DriveLines {
         }
     }
 
-    /// Counts a batch's clocks (`got`, from clock `first + 1`) into the runs that ended in it
+    /// Counts a batch's clocks (`got`; clocks numbered from `first + 1`, as the runs' ends
+    /// are, after the clock they ended on) into the runs that ended in it
     /// (`ended`, each with the clock it ended on, in order), then into `current`; `judge`
     /// takes each ended run with the flags of its last clock.
     pub fn count<'g, R: Counted>(

@@ -409,6 +409,16 @@ pub fn harness_header(inputs: &[Port], outputs: &[Port], abi: u32, idle: &[u32])
     s
 }
 
+/// The slot of the port called `name` among `ports` at `slots` (a block's own table: a name
+/// it lacks is a bug of the caller's).
+pub fn slot_named(ports: &[Port], slots: &[Slot], name: &str) -> Slot {
+    ports
+        .iter()
+        .position(|p| p.name == name)
+        .map(|k| slots[k])
+        .unwrap_or_else(|| panic!("the block has no output {name}"))
+}
+
 /// A lockstep's batch: each clock's input words and the model's output words gathered, then
 /// run on the fabric in one call and compared (the lockstep of every block but the core's).
 pub struct Batch {

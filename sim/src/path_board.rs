@@ -27,8 +27,8 @@ use snapgen_model::{CoreInputs, CoreModel, CoreOutputs, Format, PathCoreInputs, 
 use snapgen_spec::widths::PATH_SLOTS;
 
 use crate::cosim::{CoreSide, ExecutorLink};
-use crate::drive_lines::DriveLines;
-use crate::layout::{Batch, PortMismatch, Slot};
+use crate::drive_lines::{whole, DriveLines};
+use crate::layout::{slot_named, Batch, PortMismatch, Slot};
 use crate::path_core::{
     encode_inputs, encode_outputs, IN_WORDS, OUT_SLOTS, OUT_WORDS, PATH_CORE_OUTPUTS, PATH_CORE_TAG,
 };
@@ -101,13 +101,7 @@ impl PathCoreBoard {
     pub fn open(library: &FsPath, axes: u8, format: &Format) -> Result<Self, SimError> {
         let fabric = Verilated::open(library, None, PATH_CORE_TAG, IN_WORDS, OUT_WORDS)?;
         let model = PathCore::new(format, axes).map_err(|e| SimError::Config(e.to_string()))?;
-        let slot = |name: &str| {
-            PATH_CORE_OUTPUTS
-                .iter()
-                .position(|p| p.name == name)
-                .map(|k| OUT_SLOTS[k])
-                .expect("the spec's path core outputs")
-        };
+        let slot = |name: &str| slot_named(&PATH_CORE_OUTPUTS, &OUT_SLOTS, name);
         let mut drives = PathCoreInputs {
             high_clocks: 1,
             low_clocks: 1,
@@ -148,7 +142,9 @@ impl PathCoreBoard {
         b.batch
             .push(&encode_inputs(&reset), &encode_outputs(&b.model.outputs()));
         b.clock = 1;
-        b.flush().map_err(|m| SimError::Config(m.to_string()))?;
+        b.flush().map_err(|m| {
+            SimError::Config(format!("the fabric and the model differ at reset: {m}"))
+        })?;
         Ok(b)
     }
 
@@ -160,8 +156,8 @@ impl PathCoreBoard {
 
     /// The step length (whole LSB, every axis) whose pulses follow an axis moving up to
     /// `lsb_per_tick` output LSBs a tick on a board of `axes` axes, with a reversal on every
-    /// step and a margin of 2 (a step takes 1 clock to decide, 1 high, 1 low and 1 of
-    /// direction setup at a reversal).
+    /// step and a margin of 2: a step every `2 + high + low + setup` = 5 clocks (the step/dir
+    /// generator's safe rate at 1 clock each).
     pub fn step_for(axes: u8, lsb_per_tick: f64) -> Result<u16, String> {
         let steps_per_tick = f64::from(Self::tick_div(axes) + 1) / 5.0;
         let step = (2.0 * lsb_per_tick / steps_per_tick).ceil().max(1.0);
@@ -176,13 +172,34 @@ impl PathCoreBoard {
 
     /// Writes `path` into the ring, its start at the path length register's `start` (raw),
     /// and extends the path to its last segment (the ring's ports, a word a clock, from the
-    /// next clock on); the drives follow two ticks after, each axis stepping `step` LSB. A
-    /// path of more segments than the ring holds, or one the interpolator cannot take, is
-    /// refused here.
-    pub fn load_path(&mut self, path: &Path, start: i128, step: u16) -> Result<(), String> {
+    /// next clock on); on the third tick after, the drives follow (two ticks commit the
+    /// path's start), each axis stepping `step` LSB. Refused here: a path of more segments
+    /// than the ring holds, one the interpolator cannot take, and one with a run of
+    /// `SEGMENTS_PER_TICK − 1` segments shorter than `most_per_tick` (the path length a tick
+    /// may advance at most, raw): a tick could cross more segments than the board's tick has
+    /// room for.
+    pub fn load_path(
+        &mut self,
+        path: &Path,
+        start: i128,
+        step: u16,
+        most_per_tick: i128,
+    ) -> Result<(), String> {
         let n = path.segments.len();
         if n == 0 {
             return Err("the path is empty".into());
+        }
+        let window = (SEGMENTS_PER_TICK - 1) as usize;
+        for (k, run) in path.segments.windows(window).enumerate() {
+            let length: i128 = run.iter().map(|g| g.length).sum();
+            if length <= most_per_tick {
+                return Err(format!(
+                    "segments {k} to {} are {:.1} LSB long together, no more than the path may advance in a tick ({:.1} LSB): a tick could cross more than the {SEGMENTS_PER_TICK} segments this board's tick has room for: use a shorter tick (--ts), lower axis velocity limits (--vmax) or longer elements",
+                    k + window - 1,
+                    length as f64 / (1u128 << FRAC_BITS) as f64,
+                    most_per_tick as f64 / (1u128 << FRAC_BITS) as f64
+                ));
+            }
         }
         if n > PATH_SLOTS as usize - 2 {
             return Err(format!(
@@ -218,7 +235,7 @@ impl PathCoreBoard {
         path.at(x - start)
             .expect("a segment")
             .iter()
-            .map(|&p| i64::from((p >> FRAC_BITS) as u32 as i32))
+            .map(|&p| whole(p))
             .collect()
     }
 
@@ -231,6 +248,7 @@ impl PathCoreBoard {
             return Err(m);
         }
         let first = self.batch.first;
+        // (Clocks from 0 here: `enabled` is the clock whose inputs enabled the drives.)
         for (c, g) in self.batch.got().enumerate() {
             let clock = first + c as u64;
             let follows = self.enabled.is_some_and(|e| clock >= e);
@@ -321,7 +339,11 @@ impl CoreSide for PathCoreBoard {
                 // drives follow from where the rule puts the axes (the chain at rest).
                 self.settle = (left > 1).then(|| left - 1);
                 if left == 1 {
-                    self.anchor = self.rule(before.x);
+                    // Where each generator anchors its grid: its axis's committed position
+                    // (whole LSB), whatever the chain does meanwhile.
+                    self.anchor = (0..usize::from(self.axes))
+                        .map(|k| i64::from(self.model.steppers.whole(k) as i32))
+                        .collect();
                     self.drives.enable = ((1u16 << self.axes) - 1) as u8;
                     i.enable = self.drives.enable;
                     self.enabled = Some(self.clock);

@@ -34,7 +34,7 @@ use snapgen_model::{
 };
 use snapgen_plan::{plan_from, Method, MoveRequest};
 
-use crate::drive_lines::{count_error, verdict, Counted, DriveLines, EndFlags, Verdict};
+use crate::drive_lines::{count_error, verdict, whole, Counted, DriveLines, EndFlags, Verdict};
 use crate::interp::random_path;
 use crate::layout::{harness_header, port_layout, Batch};
 pub use crate::layout::{PortFault, PortMismatch};
@@ -144,11 +144,6 @@ impl Counted for Run {
     fn counted(&mut self) -> &mut [i64] {
         &mut self.counted
     }
-}
-
-/// `x`'s whole output LSBs as the step/dir generator reads them (32 bits, signed).
-fn whole(x: i128) -> i64 {
-    i64::from((x >> FRAC_BITS) as u32 as i32)
 }
 
 /// A new run for `axes` axes from `rng` (see the module documentation).

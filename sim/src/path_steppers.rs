@@ -28,7 +28,7 @@ use snapgen_model::path::sequencer::worst_clocks;
 use snapgen_model::path::steppers::PathSteppers;
 use snapgen_model::{PathSeqInputs, PathSteppersInputs, PathSteppersOutputs, FRAC_BITS};
 
-use crate::drive_lines::{count_error, verdict, Counted, DriveLines, EndFlags, Verdict};
+use crate::drive_lines::{count_error, verdict, whole, Counted, DriveLines, EndFlags, Verdict};
 use crate::interp::random_path;
 use crate::layout::{harness_header, port_layout, Batch};
 pub use crate::layout::{PortFault, PortMismatch};
@@ -125,11 +125,6 @@ impl Counted for Run {
     fn counted(&mut self) -> &mut [i64] {
         &mut self.counted
     }
-}
-
-/// `x`'s whole output LSBs as the step/dir generator reads them (32 bits, signed).
-fn whole(x: i128) -> i64 {
-    i64::from((x >> FRAC_BITS) as u32 as i32)
 }
 
 /// Runs the stream of `cfg` on the library `library` (built by

@@ -108,7 +108,9 @@ fn the_board_reads_the_axes_from_its_step_lines() {
         } else {
             PathCoreBoard::step_for(2, lsb_per_tick).unwrap()
         };
-        board.load_path(&path, home.x, step).unwrap();
+        board
+            .load_path(&path, home.x, step, (lsb_per_tick as i128) << FRAC_BITS)
+            .unwrap();
         let v = lsb_per_tick * lsb / format.ts;
         let request = MoveRequest {
             distance: 5001.0 * lsb,

@@ -391,16 +391,22 @@ fn board_run(
             ts: a.ts.unwrap_or(1e-4),
             ..design.format
         };
-        // The step length that follows the fastest axis (its velocity limit).
+        // The step length that follows the fastest axis (its velocity limit), and the most
+        // the path length may advance in a tick (every axis at its limit at once).
         let fastest = axes.iter().map(|l| l.velocity).fold(0.0, f64::max);
         let step = PathCoreBoard::step_for(axes_n, fastest / a.lsb * format.ts)
             .map_err(InputError::Board)?;
+        let path_speed: f64 = axes.iter().map(|l| l.velocity.powi(2)).sum::<f64>().sqrt();
+        let most_per_tick =
+            (path_speed / a.lsb * format.ts * 2f64.powi(FRAC_BITS as i32)).ceil() as i128;
         let built = snapgen_sim::build::build_path_core(axes_n, false)?;
         let mut board = PathCoreBoard::open(&built.library, axes_n, &format)?;
         let link = path_core_link(&mut board, &format, f64::from(a.baud));
         let (run, format, _) =
             session_run(link, a.lsb, blocks, axes, own, events, |s, path, start| {
-                s.link.lockstep().load_path(path, start, step)
+                s.link
+                    .lockstep()
+                    .load_path(path, start, step, most_per_tick)
             })?;
         let view = board.fabric_view();
         report_view(&view, &run, a.json);

@@ -91,7 +91,7 @@ impl Board {
 }
 
 /// The core a board's executor drives, in lockstep with its model: the motion core
-/// ([`Lockstep`]) or a design around it (the path core's, `crate::path_core`).
+/// ([`Lockstep`]) or a design around it (the path core's, `crate::path_board::PathCoreBoard`).
 pub trait CoreSide {
     /// A lockstep's first difference.
     type Mismatch: std::fmt::Display;
