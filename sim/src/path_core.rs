@@ -11,7 +11,11 @@
 //! after the path is in, then the program started. Its speed limit is what the slowest axis's
 //! pulses follow in a tick, times 0.2–1. A third of the moves get a **group stop** (the core's
 //! controlled stop on the path length, random stop limits) at a random clock, a twentieth an
-//! abort (the emergency stop). The run ends 20 ticks after the chain is at rest.
+//! abort (the emergency stop); two fifths get 1 to 3 **feed overrides** at random clocks: the
+//! move replanned online from the state the model predicts for a tick 2 to 40 ahead, its speed
+//! limit 0–2 times the move's (within what the pulses follow; under 5 % a stop on the path),
+//! uploaded while it plays and swapped in at that tick (the core's `swap`: the whole group's).
+//! The run ends 20 ticks after the chain is at rest.
 //!
 //! Checked beside the lockstep, from the fabric's lines alone: `late` and `refused` never
 //! raised; in a run whose every tick moves each axis, by the rule (`Path::at` of the chain's
@@ -32,7 +36,9 @@ use snapgen_model::stop::StopLimits;
 use snapgen_model::{
     Format, PathCoreInputs, PathCoreOutputs, PathSeqInputs, Quantity, DEFAULT_FORMAT, FRAC_BITS,
 };
+use snapgen_plan::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
 use snapgen_plan::{plan_from, Method, MoveRequest};
+use snapgen_spec::widths::MAX_SEGMENTS;
 
 use crate::drive_lines::{count_error, verdict, whole, Counted, DriveLines, EndFlags, Verdict};
 use crate::interp::random_path;
@@ -91,6 +97,8 @@ pub struct PathCoreReport {
     pub ticks: u64,
     /// Runs with a group stop, and with an abort.
     pub stops: u64,
+    /// Feed overrides swapped in (program swaps at a tick while the move plays).
+    pub swaps: u64,
     /// See [`PathCoreReport::stops`].
     pub aborts: u64,
     /// Steps counted on the fabric's lines (every axis).
@@ -128,6 +136,15 @@ struct Run {
     clocks: u64,
     stop_at: Option<u64>,
     abort_at: Option<u64>,
+    /// Clocks since the start at which the move is replanned (a feed override), in order.
+    replan_at: Vec<u64>,
+    /// The move's limits on the path length (units/s, /s², /s³), the speed the slowest
+    /// axis's pulses follow, the cell it goes to, and the tick its program ends on (before
+    /// the start: its length in ticks).
+    limits: OnlineLimits,
+    follow_speed: f64,
+    end_cell: i128,
+    ends_at: u64,
     /// Each axis's steps a tick at most (within the rate), whole positions at the anchor,
     /// steps counted on its lines, its position by the rule at the last tick, and whether a
     /// tick moved it further than its pulses follow.
@@ -269,6 +286,14 @@ fn new_run(rng: &mut StdRng, axes: u8) -> Run {
         let clocks = plan.ticks_total() * period;
         let stop_at = rng.gen_bool(0.33).then(|| rng.gen_range(1..=clocks));
         let abort_at = (stop_at.is_none() && rng.gen_bool(0.05)).then(|| rng.gen_range(1..=clocks));
+        let mut replan_at: Vec<u64> = if rng.gen_bool(0.4) {
+            (0..rng.gen_range(1..=3))
+                .map(|_| rng.gen_range(1..=clocks))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        replan_at.sort_unstable();
         return Run {
             path,
             queue,
@@ -278,6 +303,17 @@ fn new_run(rng: &mut StdRng, axes: u8) -> Run {
             clocks: 0,
             stop_at,
             abort_at,
+            replan_at,
+            limits: OnlineLimits {
+                velocity: v,
+                acceleration: a,
+                deceleration: a,
+                jerk: j,
+            },
+            follow_speed: slowest as f64 * lsb / ts,
+            end_cell: f.output_lsb(home.x) + cells,
+            // The program's ticks until it starts (then the tick it ends on).
+            ends_at: plan.ticks_total(),
             follows,
             start: vec![0; n],
             counted: vec![0; n],
@@ -312,7 +348,7 @@ pub fn run(library: &FsPath, cfg: &PathCoreConfig) -> Result<PathCoreReport, Sim
                 current = Some(run);
                 i
             }
-            Some(run) => next_inputs(run, &model, &mut r),
+            Some(run) => next_inputs(run, &model, &mut r, &mut rng),
         };
         model.clock(&i);
         let o = model.outputs();
@@ -346,7 +382,12 @@ pub fn run(library: &FsPath, cfg: &PathCoreConfig) -> Result<PathCoreReport, Sim
 }
 
 /// The run's inputs for the next clock, from the model's outputs as they stand.
-fn next_inputs(run: &mut Run, model: &PathCore, r: &mut PathCoreReport) -> PathCoreInputs {
+fn next_inputs(
+    run: &mut Run,
+    model: &PathCore,
+    r: &mut PathCoreReport,
+    rng: &mut StdRng,
+) -> PathCoreInputs {
     if let Some(w) = run.queue.pop_front() {
         return w;
     }
@@ -390,6 +431,9 @@ fn next_inputs(run: &mut Run, model: &PathCore, r: &mut PathCoreReport) -> PathC
             if run.ticks == 4 && o.tick {
                 i.start = true;
                 run.stage = Stage::Moving;
+                // From here every input, queued ones too, keeps the drives following.
+                run.rest.enable = all;
+                run.ends_at += o.ticks + 1;
             }
         }
         Stage::Moving => {
@@ -403,7 +447,11 @@ fn next_inputs(run: &mut Run, model: &PathCore, r: &mut PathCoreReport) -> PathC
                 i.abort_move = true;
                 r.aborts += 1;
             }
-            if run.clocks > 2 && !o.busy && !o.stopping && o.at_rest {
+            if run.replan_at.first() == Some(&run.clocks) {
+                run.replan_at.remove(0);
+                replan(run, model, r, rng);
+            }
+            if run.clocks > 2 && !o.busy && !o.stopping && !o.swap_pending && o.at_rest {
                 run.stage = Stage::Tail(20);
             }
         }
@@ -415,6 +463,67 @@ fn next_inputs(run: &mut Run, model: &PathCore, r: &mut PathCoreReport) -> PathC
         }
     }
     i
+}
+
+/// A feed override while the move plays: the move replanned online (order 3) from the state
+/// the model predicts for a tick 2 to 40 ahead, its speed limit the move's times 0–2 (at most
+/// what the slowest axis's pulses follow; below 5 %: a stop on the path), to the move's cell
+/// at rest; uploaded into the standby bank and swapped in at that tick. Skipped when the
+/// program ends before then, a stop runs or a swap is armed.
+fn replan(run: &mut Run, model: &PathCore, r: &mut PathCoreReport, rng: &mut StdRng) {
+    let o = model.outputs();
+    let at = o.ticks + rng.gen_range(2..=40);
+    if at + 2 >= run.ends_at || o.swap_pending || o.stopping {
+        return;
+    }
+    let idle = PathCore::core_inputs(&run.rest);
+    let mut m = model.core.clone();
+    while m.outputs().ticks < at {
+        m.edge(&idle);
+    }
+    let start = m.chain();
+    let k: f64 = rng.gen_range(0.0..=2.0);
+    let limits = OnlineLimits {
+        velocity: (run.limits.velocity * k).clamp(1e-9, run.follow_speed),
+        ..run.limits
+    };
+    let target = if k < 0.05 {
+        OnlineTarget::Velocity(0.0)
+    } else {
+        OnlineTarget::Position {
+            cell: run.end_cell,
+            velocity: 0.0,
+        }
+    };
+    let f = Format::with_ts(1e-4);
+    let Ok(plan) = plan_online(&start, &target, &limits, OnlineOrder::Three, &f) else {
+        return;
+    };
+    let program = &plan.program;
+    if program.total_ticks() > MAX_RUN_TICKS || program.segments.len() > MAX_SEGMENTS as usize {
+        return;
+    }
+    for (k, seg) in program.segments.iter().enumerate() {
+        run.queue.push_back(PathCoreInputs {
+            write_enable: true,
+            write_address: k as u8,
+            write_ticks: seg.ticks,
+            write_snap: seg.snap,
+            ..run.rest
+        });
+    }
+    run.queue.push_back(PathCoreInputs {
+        count_enable: true,
+        count_value: program.segments.len() as u8,
+        ..run.rest
+    });
+    run.queue.push_back(PathCoreInputs {
+        swap: true,
+        swap_last: (at - 1) as u32,
+        ..run.rest
+    });
+    run.ends_at = at + program.total_ticks();
+    r.swaps += 1;
 }
 
 /// The drives' view of a run that ended with the fabric's `overrun`, `late` and `refused`

@@ -27,7 +27,7 @@ fn fabric_model_and_drives_agree() {
             r.runs > 3 && 2 * r.checked > r.runs && r.steps > 1_000,
             "{r:?}"
         );
-        assert!(r.stops > 0, "{r:?}");
+        assert!(r.stops > 0 && r.swaps > 0, "{r:?}");
     }
 }
 

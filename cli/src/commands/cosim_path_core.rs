@@ -1,6 +1,6 @@
 //! `snapgen cosim-path-core`: the Verilated path core (the motion core on the path length
 //! driving the path steppers) against its model, every output on every clock, under random
-//! paths, moves and group stops; each axis's steps counted on its lines against the rule
+//! paths, moves, feed overrides and group stops; each axis's steps counted on its lines against the rule
 //! (issue 22).
 
 use std::time::Instant;
@@ -41,12 +41,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let r = path_core::run(&built.library, &cfg)?;
     let secs = t.elapsed().as_secs_f64();
     println!(
-        "path core co-simulation, {} axes: {} clocks compared ({} ticks), {} runs ({} group stops, {} aborts), {} mismatches; {:.2} M clocks/s",
+        "path core co-simulation, {} axes: {} clocks compared ({} ticks), {} runs ({} group stops, {} feed overrides swapped in, {} aborts), {} mismatches; {:.2} M clocks/s",
         a.axes,
         r.clocks,
         r.ticks,
         r.runs,
         r.stops,
+        r.swaps,
         r.aborts,
         u32::from(r.mismatch.is_some()),
         r.clocks as f64 / secs / 1e6
