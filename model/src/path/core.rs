@@ -19,7 +19,7 @@ use super::steppers::PathSteppers;
 use crate::core::CoreModel;
 use crate::format::Format;
 use crate::ports::{
-    CoreInputs, CoreOutputs, PathCoreInputs, PathCoreOutputs, PathSeqInputs, PathSteppersInputs,
+    CoreInputs, CoreOutputs, PathCoreInputs, PathCoreOutputs, PathSteppersInputs,
     PathSteppersOutputs,
 };
 
@@ -121,32 +121,10 @@ macro_rules! outputs_of {
     };
 }
 
-/// `PathCore::host_inputs`: the path sequencer's writes and extensions, by name.
-macro_rules! host_inputs_of {
-    (
-        clock: $cdoc:literal;
-        inputs {
-            reset { $($reset:tt)* }
-            write { $( $w:ident : $wk:ident [$wb:expr] $wt:ty, $wdoc:literal; )* }
-            extend { $( $e:ident : $ek:ident [$eb:expr] $et:ty, $edoc:literal; )* }
-            $($rest:tt)*
-        }
-        outputs { $($outs:tt)* }
-    ) => {
-        /// The path core's inputs `rest` with the sequencer's writes and extension of `w`
-        /// (as [`super::sequencer::segment_writes`] makes them).
-        pub fn host_inputs(w: &PathSeqInputs, rest: &PathCoreInputs) -> PathCoreInputs {
-            PathCoreInputs {
-                $( $w: w.$w, )*
-                $( $e: w.$e, )*
-                ..*rest
-            }
-        }
-    };
-}
-
 impl PathCore {
-    snapgen_spec::with_path_sequencer_ports!(host_inputs_of! {});
+    snapgen_spec::with_path_sequencer_ports!(
+        super::host_inputs_of! { host_inputs, PathCoreInputs; }
+    );
     snapgen_spec::with_motion_core_ports!(core_inputs_of! {});
     snapgen_spec::with_motion_core_ports!(with_core_of! {});
     snapgen_spec::with_path_steppers_ports!(steppers_inputs_of! {});

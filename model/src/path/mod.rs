@@ -16,3 +16,31 @@ pub mod engine;
 pub mod interp;
 pub mod sequencer;
 pub mod steppers;
+
+/// `$name(w, rest)` in a block's `impl` (`$target` its inputs, which hold the path
+/// sequencer's `write` and `extend` ports by name): `rest` with the writes and extension of
+/// `w`, each port copied by name from the spec's list.
+macro_rules! host_inputs_of {
+    (
+        $name:ident, $target:ident;
+        clock: $cdoc:literal;
+        inputs {
+            reset { $($reset:tt)* }
+            write { $( $w:ident : $wk:ident [$wb:expr] $wt:ty, $wdoc:literal; )* }
+            extend { $( $e:ident : $ek:ident [$eb:expr] $et:ty, $edoc:literal; )* }
+            $($rest:tt)*
+        }
+        outputs { $($outs:tt)* }
+    ) => {
+        /// The inputs `rest` with the sequencer's writes and extension of `w` (as
+        /// [`crate::path::sequencer::segment_writes`] makes them).
+        pub fn $name(w: &crate::ports::PathSeqInputs, rest: &$target) -> $target {
+            $target {
+                $( $w: w.$w, )*
+                $( $e: w.$e, )*
+                ..*rest
+            }
+        }
+    };
+}
+pub(crate) use host_inputs_of;

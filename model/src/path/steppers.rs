@@ -29,6 +29,35 @@ use crate::ports::{PathSeqInputs, PathSteppersInputs, PathSteppersOutputs, StepD
 
 const _: () = assert!(STEP_TIMER_BITS == 16 && POSITION_BITS == 32 && MAX_AXES == 8);
 
+/// `PathSteppers::sequencer_inputs`: the sequencer's inputs of the stage's, each by name
+/// from the spec's list (the interpolator's `done` from its outputs).
+macro_rules! sequencer_inputs_of {
+    (
+        clock: $cdoc:literal;
+        inputs {
+            reset { $( $r:ident : $rk:ident [$rb:expr] $rt:ty, $rdoc:literal; )* }
+            write { $( $w:ident : $wk:ident [$wb:expr] $wt:ty, $wdoc:literal; )* }
+            extend { $( $e:ident : $ek:ident [$eb:expr] $et:ty, $edoc:literal; )* }
+            tick { $( $t:ident : $tk:ident [$tb:expr] $tt:ty, $tdoc:literal; )* }
+            interpolator { $( $d:ident : $dk:ident [$db:expr] $dt:ty, $ddoc:literal; )* }
+        }
+        outputs { $($outs:tt)* }
+    ) => {
+        /// The sequencer's inputs of the stage's inputs `i` (the interpolator's answer from
+        /// its outputs after the last clock).
+        fn sequencer_inputs(&self, i: &PathSteppersInputs) -> PathSeqInputs {
+            let answer = self.interpolator.outputs();
+            PathSeqInputs {
+                $( $r: i.$r, )*
+                $( $w: i.$w, )*
+                $( $e: i.$e, )*
+                $( $t: i.$t, )*
+                $( $d: answer.$d, )*
+            }
+        }
+    };
+}
+
 /// The stage's blocks and registers.
 #[derive(Clone, Debug)]
 pub struct PathSteppers {
@@ -77,63 +106,15 @@ impl PathSteppers {
         (self.position[k] >> FRAC_BITS) as u32
     }
 
+    snapgen_spec::with_path_sequencer_ports!(super::host_inputs_of! {
+        with_writes, PathSteppersInputs;
+    });
+    snapgen_spec::with_path_sequencer_ports!(sequencer_inputs_of! {});
+
     /// The stage's inputs that carry the sequencer's host-side inputs `w` (its writes and
     /// extensions; every other input at rest).
     pub fn host_inputs(w: &PathSeqInputs) -> PathSteppersInputs {
-        PathSteppersInputs {
-            seg_index: w.seg_index,
-            write_span: w.write_span,
-            seg_start: w.seg_start,
-            seg_length: w.seg_length,
-            write_shape: w.write_shape,
-            seg_arc: w.seg_arc,
-            seg_ccw: w.seg_ccw,
-            seg_plane_first: w.seg_plane_first,
-            seg_plane_second: w.seg_plane_second,
-            seg_centre_first: w.seg_centre_first,
-            seg_centre_second: w.seg_centre_second,
-            seg_radius: w.seg_radius,
-            seg_growth: w.seg_growth,
-            seg_start_angle: w.seg_start_angle,
-            seg_rate: w.seg_rate,
-            write_axis: w.write_axis,
-            seg_axis: w.seg_axis,
-            seg_from: w.seg_from,
-            seg_share: w.seg_share,
-            extend: w.extend,
-            ..Default::default()
-        }
-    }
-
-    /// The sequencer's inputs of the stage's inputs `i` (the interpolator's `done` from its
-    /// outputs after the last clock).
-    fn sequencer_inputs(&self, i: &PathSteppersInputs) -> PathSeqInputs {
-        PathSeqInputs {
-            reset: i.reset,
-            seg_index: i.seg_index,
-            write_span: i.write_span,
-            seg_start: i.seg_start,
-            seg_length: i.seg_length,
-            write_shape: i.write_shape,
-            seg_arc: i.seg_arc,
-            seg_ccw: i.seg_ccw,
-            seg_plane_first: i.seg_plane_first,
-            seg_plane_second: i.seg_plane_second,
-            seg_centre_first: i.seg_centre_first,
-            seg_centre_second: i.seg_centre_second,
-            seg_radius: i.seg_radius,
-            seg_growth: i.seg_growth,
-            seg_start_angle: i.seg_start_angle,
-            seg_rate: i.seg_rate,
-            write_axis: i.write_axis,
-            seg_axis: i.seg_axis,
-            seg_from: i.seg_from,
-            seg_share: i.seg_share,
-            extend: i.extend,
-            tick: i.tick,
-            s: i.s,
-            done: self.interpolator.outputs().done,
-        }
+        Self::with_writes(w, &PathSteppersInputs::default())
     }
 
     /// One clock edge with inputs `i`: every block and register from the values before it.
