@@ -11,7 +11,9 @@
 //!   on an element after the current one, never before it; an element is left only once the
 //!   trace has come within a step of its end, following its progress a step at a time, and
 //!   every junction a step passes must lie within that step's box widened by the bound: an
-//!   element passed over within one tick, never a detour skipped nor a full turn cut short),
+//!   element passed over within one tick, never a detour skipped nor a full turn cut short; a
+//!   point within the bound of two elements near their junction is read both ways until the
+//!   trace decides),
 //!   and the trace ends exactly on the last element's end point. A line's bound is per axis ([`line`]: a point of the exact segment
 //!   exists from which every axis is within `b`), an arc's is radial in its plane and per axis
 //!   off it ([`arc`]). Lines and the radial and angular tests of arcs are exact (integer
@@ -272,52 +274,68 @@ pub fn follow(
         }));
     }
     let reach = bounds.line.max(bounds.arc);
-    let mut at = 0;
-    // How far the trace has come along the current element (0 to 1).
-    let mut reached = 0.0f64;
+    // Every way of following the path so far: the element the trace is on and how far it
+    // has come along it (0 to 1). Near a junction a point may lie within the bound of both
+    // elements (at a sharp corner approached a cell at a time, still on the first; just past
+    // a tangent one, already on the second): both readings are kept until the trace decides.
+    let mut ways: Vec<(usize, f64)> = vec![(0, 0.0)];
     for (tick, p) in trace.iter().enumerate() {
         let prev = &trace[tick.saturating_sub(1)];
-        // This step's length, and the share of the current element it and the bound cover.
+        // This step's length.
         let step = prev
             .iter()
             .zip(p)
             .map(|(&a, &b)| ((b - a) as f64).powi(2))
             .sum::<f64>()
             .sqrt();
-        let (progress, length) = path[at].progress(p);
-        // (Twice the step: a chord of an arc is shorter than the arc, at most by π/2.)
-        let slack = (2.0 * step + 2.0 * reach as f64 + 1.0) / length.max(1.0);
-        // Leave the current element only from its end (within a step), for the first later
-        // element that holds the point, every junction on the way within the step's box.
-        if reached >= 1.0 - slack {
-            let within = |q: &[i128]| {
-                q.iter()
-                    .zip(prev.iter().zip(p))
-                    .all(|(&x, (&a, &b))| a.min(b) - reach <= x && x <= a.max(b) + reach)
-            };
-            let next = (at + 1..path.len())
-                .take_while(|&k| within(path[k].from()))
-                .find(|&k| path[k].holds(p, bounds));
-            if let Some(k) = next {
-                at = k;
-                entered[k] = Some(tick);
-                reached = path[k].progress(p).0;
-                continue;
+        let within = |q: &[i128]| {
+            q.iter()
+                .zip(prev.iter().zip(p))
+                .all(|(&x, (&a, &b))| a.min(b) - reach <= x && x <= a.max(b) + reach)
+        };
+        let mut next: Vec<(usize, f64)> = Vec::new();
+        let mut keep = |at: usize, reached: f64| match next.iter_mut().find(|w| w.0 == at) {
+            Some(w) => w.1 = w.1.max(reached),
+            None => next.push((at, reached)),
+        };
+        for &(at, reached) in &ways {
+            let (progress, length) = path[at].progress(p);
+            // The share of the element the step and the bound cover. (Twice the step: a chord
+            // of an arc is shorter than the arc, at most by π/2.)
+            let slack = (2.0 * step + 2.0 * reach as f64 + 1.0) / length.max(1.0);
+            // Leave the element only from its end (within a step), for the first later
+            // element that holds the point, every junction on the way within the step's box.
+            if reached >= 1.0 - slack {
+                let onto = (at + 1..path.len())
+                    .take_while(|&k| within(path[k].from()))
+                    .find(|&k| path[k].holds(p, bounds));
+                if let Some(k) = onto {
+                    entered[k].get_or_insert(tick);
+                    keep(k, path[k].progress(p).0);
+                }
+            }
+            if path[at].holds(p, bounds) {
+                entered[at].get_or_insert(tick);
+                // Progress counts only as far as a step can go (a point just behind a full
+                // turn's start is not its end).
+                keep(
+                    at,
+                    if progress <= reached + slack {
+                        reached.max(progress)
+                    } else {
+                        reached
+                    },
+                );
             }
         }
-        if !path[at].holds(p, bounds) {
+        if next.is_empty() {
             return Ok(Err(Deviation::OffPath {
                 tick,
-                element: at,
+                element: ways.iter().map(|w| w.0).max().unwrap_or(0),
                 point: p.clone(),
             }));
         }
-        entered[at].get_or_insert(tick);
-        // Progress counts only as far as a step can go (a point just behind a full turn's
-        // start is not its end).
-        if progress <= reached + slack {
-            reached = reached.max(progress);
-        }
+        ways = next;
     }
     let end = path[path.len() - 1].to();
     match trace.last() {
