@@ -301,32 +301,7 @@ fn arc(
             ))
         }
         (_, _, Some(r)) if word(letters[p]).is_none() && word(letters[q]).is_none() => {
-            let (sx, sy, ex, ey) = (at[p] as f64, at[q] as f64, to[p] as f64, to[q] as f64);
-            let chord = (ex - sx).hypot(ey - sy);
-            if chord == 0.0 {
-                return Err(bad(
-                    "a full turn cannot be given by its radius: give its centre (I J K)".into(),
-                ));
-            }
-            let r = r as f64;
-            let h2 = r * r - chord * chord / 4.0;
-            if h2 < -1.0 {
-                return Err(bad(format!(
-                    "radius {} mm is shorter than half the chord to the end point ({} mm)",
-                    r.abs() * lsb,
-                    chord / 2.0 * lsb
-                )));
-            }
-            let h = h2.max(0.0).sqrt();
-            // The centre on the chord's left (counter-clockwise arc of at most half a turn)
-            // or right; R < 0 asks for the longer arc.
-            let (ux, uy) = ((ex - sx) / chord, (ey - sy) / chord);
-            let left = ccw == (r > 0.0);
-            let side = if left { 1.0 } else { -1.0 };
-            [
-                ((sx + ex) / 2.0 - side * h * uy).round() as i64,
-                ((sy + ey) / 2.0 + side * h * ux).round() as i64,
-            ]
+            centre_of_radius([at[p], at[q]], [to[p], to[q]], r as f64, ccw, lsb).map_err(bad)?
         }
         (i, j, None) => [
             at[p].saturating_add(i.unwrap_or(0)),
@@ -358,6 +333,40 @@ fn arc(
     })
 }
 
+/// The centre (in the arc's plane, LSB) of an arc of radius `r` LSB from `at` to `to`:
+/// on the chord's left for a counter-clockwise arc of at most half a turn, on its right
+/// clockwise; `r < 0` asks for the longer arc (G-code's R, PLCopen's radius mode). Refused
+/// (why, `lsb` mm an LSB) for a full turn or a radius shorter than half the chord.
+pub fn centre_of_radius(
+    at: [i64; 2],
+    to: [i64; 2],
+    r: f64,
+    ccw: bool,
+    lsb: f64,
+) -> Result<[i64; 2], String> {
+    let (sx, sy, ex, ey) = (at[0] as f64, at[1] as f64, to[0] as f64, to[1] as f64);
+    let chord = (ex - sx).hypot(ey - sy);
+    if chord == 0.0 {
+        return Err("a full turn cannot be given by its radius: give its centre".into());
+    }
+    let h2 = r * r - chord * chord / 4.0;
+    if h2 < -1.0 {
+        return Err(format!(
+            "radius {} mm is shorter than half the chord to the end point ({} mm)",
+            r.abs() * lsb,
+            chord / 2.0 * lsb
+        ));
+    }
+    let h = h2.max(0.0).sqrt();
+    let (ux, uy) = ((ex - sx) / chord, (ey - sy) / chord);
+    let left = ccw == (r > 0.0);
+    let side = if left { 1.0 } else { -1.0 };
+    Ok([
+        ((sx + ex) / 2.0 - side * h * uy).round() as i64,
+        ((sy + ey) / 2.0 + side * h * ux).round() as i64,
+    ])
+}
+
 /// Each point's distance from `c` (LSB), as the path's preparation measures it.
 fn radii(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> (f64, f64) {
     let r = |v: [i64; 2]| ((v[0] - c[0]) as f64).hypot((v[1] - c[1]) as f64);
@@ -370,7 +379,7 @@ fn radii(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> (f64, f64) {
 /// the chord, whose radii differ by at most an LSB, provided it lies within `tolerance` of `c`
 /// (a short chord would move the centre far: refused). Otherwise why not (`lsb` mm an LSB,
 /// for the message).
-fn corrected_centre(
+pub fn corrected_centre(
     a: [i64; 2],
     b: [i64; 2],
     c: [i64; 2],

@@ -24,6 +24,7 @@ use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::PlayError as ScriptError;
 use snapgen_host::path::board::{play_on_board_with, BoardError};
 use snapgen_host::path::group::MAX_EVENT_MS;
+use snapgen_host::path::group::STOP_MARGIN;
 use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::Session;
@@ -289,6 +290,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "checked": passed,
             "deviation": c.deviation.as_ref().map(|d| format!("{d:?}")),
             "exceeded": c.exceeded.as_ref().map(|e| format!("{e:?}")),
+            "board_stop": run.stop.map(|s| serde_json::json!({
+                "deceleration": s.deceleration,
+                "jerk": s.jerk,
+            })),
         });
         println!("{v}");
     } else {
@@ -318,6 +323,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             run.blocks.len(),
             ticks as f64 * format.ts
         );
+        if let Some(s) = run.stop {
+            println!(
+                "the board's controlled stop (a group stop on the path): {:.1} mm/s², {:.0} mm/s³, within every axis on every element; every move within {:.0} % and {:.0} % of them",
+                s.deceleration,
+                s.jerk,
+                100.0 * (1.0 - STOP_MARGIN),
+                100.0 * (1.0 - STOP_MARGIN).powi(2)
+            );
+        }
         println!("farthest from the programmed path: {farthest:.3e} LSB");
         for (name, [v, aa, j]) in ["X", "Y", "Z"].iter().zip(&c.peaks) {
             println!("{name}: peaks {v:.3} mm/s, {aa:.1} mm/s², {j:.0} mm/s³");

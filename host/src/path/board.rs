@@ -71,7 +71,10 @@ fn script(g: &mut Group, events: &[PathEvent]) -> (Vec<Event>, Vec<Option<usize>
 
 /// Plays `blocks` as `events` let them enter, with the path's `own` limits, on the board of
 /// `session`: the run's report and the path played (every axis on every tick from the
-/// board's register), with the stop-limit rule's warnings.
+/// board's register), with the stop-limit rule's warnings. The board's controlled stop is
+/// the path's largest within every axis on every element (`Group::stop_limits`), every move
+/// within it (`Group::for_board_stop`): a group stop from any tick stays on the path within
+/// the axes' limits.
 pub fn play_on_board<L: Link>(
     session: &mut Session<L>,
     blocks: &[Block],
@@ -99,13 +102,16 @@ pub fn play_on_board_with<L: Link>(
     let at = session
         .state()
         .map_err(|e| BoardError::State(e.to_string()))?;
-    let mut g = Group::new(blocks, axes, own, &format)?.on_board(at.x)?;
+    let mut g = Group::new(blocks, axes, own, &format)?
+        .on_board(at.x)?
+        .for_board_stop();
+    let stop = g.stop_limits();
     let (driver_events, first) = script(&mut g, events);
     load(session, &g.path(), g.start_register()).map_err(BoardError::Load)?;
     let opts = PlayOptions {
         order: OnlineOrder::Three,
-        stop_deceleration: None,
-        stop_jerk: None,
+        stop_deceleration: Some(stop.deceleration),
+        stop_jerk: Some(stop.jerk),
         run,
     };
     let (report, _, warnings) = play(session, &driver_events, &opts)?;
@@ -116,6 +122,7 @@ pub fn play_on_board_with<L: Link>(
         .map(|k| k.state.x)
         .collect();
     let mut played = collect(&g, &report.axis, blocks, lengths)?;
+    played.stop = Some(stop);
     played.taken = first
         .iter()
         .map(|f| {

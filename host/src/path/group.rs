@@ -25,12 +25,12 @@ use snapgen_model::path::interp::Path;
 use snapgen_model::FRAC_BITS;
 use snapgen_plan::online::OnlineOrder;
 use snapgen_plan::path::junction::{frames, junction_speed, lookahead, Ahead, Frame};
-use snapgen_plan::path::speed::{element_limits, Limits, MARGIN};
+use snapgen_plan::path::speed::{element_limits, Geometry, Limits, MARGIN};
 use snapgen_plan::path::{prepare, raw, Element, Prepared};
 
 use crate::axis::compose::Request;
 use crate::axis::{
-    AxisErrorId, AxisSettings, BufferMode, HostAxis, MotionCommand, OnPath, Outcome,
+    AxisErrorId, AxisSettings, BufferMode, Goal, HostAxis, MotionCommand, OnPath, Outcome,
 };
 
 use super::PlayError;
@@ -68,6 +68,7 @@ pub struct PathEvent {
 }
 
 /// An element as the planner prepared it.
+#[derive(Clone)]
 pub(super) struct Planned {
     /// Its limits on `s` (its feed and its geometry; the path's own apply on top).
     pub limits: Limits,
@@ -82,13 +83,23 @@ pub(super) struct Planned {
     /// The speed its start may be passed at (its junction's, unstretched; 0 from rest, at
     /// a corner, into or out of a rapid).
     pub junction: f64,
+    /// Its limits before a junction took a share of them ([`Group::join`]).
+    base: Limits,
+    /// The path's own limits on it, when given.
+    own: Option<PathLimits>,
+    /// Its geometry (units).
+    geometry: Geometry,
+    /// The axes that keep half their limits for a junction at speed.
+    spiked: Vec<bool>,
 }
 
 /// The group playing a program.
-pub struct Group<'a> {
-    legs: &'a [Block],
-    axes: &'a [Limits],
-    own: Option<PathLimits>,
+#[derive(Clone)]
+pub struct Group {
+    legs: Vec<Block>,
+    axes: Vec<Limits>,
+    /// The cells (LSB) every axis starts in.
+    from: Vec<i64>,
     format: Format,
     planned: Vec<Planned>,
     /// The entry speed each entered element was given.
@@ -116,6 +127,28 @@ pub struct Group<'a> {
     /// Junction speeds are passed at this multiple of what the planner allows (1; the tests
     /// raise it to show that the limit is needed and that the check sees it).
     junction_scale: f64,
+    /// The board's controlled stop every move keeps within ([`Group::for_board_stop`]).
+    stop: Option<BoardStop>,
+}
+
+/// The share of a board's stop limits the moves keep free ([`Group::for_board_stop`]): their
+/// deceleration is at most `1 − m` of the stop's, their jerk `(1 − m)²` of its.
+///
+/// Why the jerk keeps more: from a speed `v` a jerk-limited brake that holds `A` and releases
+/// at `J` covers `v²/(2A) + A³/(24J²)`. A move braking with `αA` and `βJ` covers
+/// `v²/(2αA) + α³A³/(24β²J²)`; the stop covers no more from any `v` (it brakes at once, and
+/// harder) only if `β² ≤ α³`, or at the end of a brake, where `v` is small, its longer release
+/// carries it past the move's rest (measured: 0.018 of a cell past a corner with `β = α`).
+/// `α = 1 − m`, `β = (1 − m)²` keeps `β² = α⁴ < α³`.
+pub const STOP_MARGIN: f64 = 0.02;
+
+/// A board's controlled stop on the path length (units/s², /s³).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardStop {
+    /// Deceleration.
+    pub deceleration: f64,
+    /// Jerk.
+    pub jerk: f64,
 }
 
 /// A move on `s` shorter than this many ticks at its speed shares a move with the element it
@@ -164,109 +197,28 @@ pub(super) fn s0() -> i128 {
     raw(0)
 }
 
-impl<'a> Group<'a> {
+impl Group {
     /// Prepares every element of `legs` (a G-code program's blocks, or any path given as
-    /// blocks) from the origin (all axes at 0) for `axes` limited by
-    /// theirs and the path by `own`: an element that cannot be played is refused here,
-    /// before anything moves.
+    /// blocks) from the origin (all axes at 0) for `axes` limited by theirs and the path by
+    /// `own`: an element that cannot be played is refused here, before anything moves. A
+    /// block joins the one before at speed where both have a feed (no rapid) and their
+    /// junction allows it.
     pub fn new(
-        legs: &'a [Block],
-        axes: &'a [Limits],
+        legs: &[Block],
+        axes: &[Limits],
         own: Option<PathLimits>,
         format: &Format,
     ) -> Result<Self, PlayError> {
-        let mut at = vec![0i64; axes.len()];
-        let mut planned = Vec::new();
-        let mut geometries = Vec::new();
-        // The path length register: the host axis's positions (half its range, a cell per
-        // element for the fitting).
-        let most = format.physical_max(Quantity::Position) * 0.5;
-        let mut total = 0.0;
+        let mut g = Group::starting_at(&vec![0; axes.len()], axes, format);
         for leg in legs {
-            let line = leg.line;
-            let prepared = prepare(&at, std::slice::from_ref(&leg.element))
-                .map_err(|source| PlayError::Path { line, source })?;
-            let g = &prepared.geometries()[0];
-            let physical = g.scaled(format.position_lsb);
-            let geometric =
-                element_limits(&physical, axes, f64::INFINITY).ok_or(PlayError::Still { line })?;
-            geometries.push(physical.clone());
-            let limits = Limits {
-                velocity: geometric.velocity.min(leg.feed.unwrap_or(f64::INFINITY)),
-                ..geometric
-            };
-            let length = prepared.length_physical(format.position_lsb);
-            total += length + format.position_lsb;
-            if total > most {
-                return Err(PlayError::TooLong {
-                    line,
-                    length: total,
-                    most,
-                });
-            }
-            let frames = frames(
-                &at,
-                &leg.element,
-                g,
-                prepared.length() as f64 / 2f64.powi(FRAC_BITS as i32),
-            );
-            planned.push(Planned {
-                limits,
-                cap: geometric.velocity,
-                length,
-                frames,
-                prepared,
-                junction: 0.0,
-            });
-            at = leg.element.to().to_vec();
+            g.push(leg.clone(), true, own)?;
         }
-        // Each junction's speed (0 from rest, at a corner, into or out of a rapid). On a line
-        // that meets another element at speed, an axis whose direction share or curvature
-        // changes there keeps half of its acceleration and jerk for that change, as an arc
-        // keeps half for its centripetal terms (`snapgen_plan::path::junction`).
-        let mut spiked = vec![vec![false; axes.len()]; planned.len()];
-        for k in 1..planned.len() {
-            if legs[k].feed.is_none() || legs[k - 1].feed.is_none() {
-                continue;
-            }
-            let (before, after) = (&planned[k - 1].frames.1, &planned[k].frames.0);
-            let v = junction_speed(before, after, axes, format.ts, format.position_lsb);
-            if v > 0.0 {
-                let changes: Vec<bool> = (0..axes.len())
-                    .map(|i| {
-                        before.direction[i] != after.direction[i]
-                            || before.curvature[i] != after.curvature[i]
-                    })
-                    .collect();
-                for e in [k - 1, k] {
-                    for (s, &c) in spiked[e].iter_mut().zip(&changes) {
-                        *s |= c;
-                    }
-                }
-            }
-            planned[k].junction = v;
-        }
-        for (k, leg) in legs.iter().enumerate() {
-            if matches!(leg.element, Element::Line { .. }) && spiked[k].contains(&true) {
-                let halved: Vec<Limits> = axes
-                    .iter()
-                    .zip(&spiked[k])
-                    .map(|(l, &h)| {
-                        let f = if h { 0.5 } else { 1.0 };
-                        Limits {
-                            velocity: l.velocity,
-                            acceleration: l.acceleration * f,
-                            jerk: l.jerk * f,
-                        }
-                    })
-                    .collect();
-                let p = &mut planned[k];
-                if let Some(l) = element_limits(&geometries[k], &halved, f64::INFINITY) {
-                    p.limits.acceleration = l.acceleration;
-                    p.limits.jerk = l.jerk;
-                }
-            }
-        }
+        Ok(g)
+    }
+
+    /// A group with no element yet, its axes in the cells `from` (LSB) for `axes` limited by
+    /// theirs: elements join it by [`Group::push`].
+    pub fn starting_at(from: &[i64], axes: &[Limits], format: &Format) -> Self {
         let settings = AxisSettings {
             format: *format,
             order: OnlineOrder::Three,
@@ -277,12 +229,12 @@ impl<'a> Group<'a> {
             a: 0,
             j: 0,
         };
-        Ok(Group {
-            legs,
-            axes,
-            own,
+        Group {
+            legs: Vec::new(),
+            axes: axes.to_vec(),
+            from: from.to_vec(),
             format: *format,
-            planned,
+            planned: Vec::new(),
             entries: Vec::new(),
             bounds: Vec::new(),
             stretch: Vec::new(),
@@ -290,12 +242,146 @@ impl<'a> Group<'a> {
             commands: Vec::new(),
             moves: Vec::new(),
             origin_cell: 0,
-            total,
+            total: 0.0,
             axis: HostAxis::new(settings, 0, origin),
             refused: Vec::new(),
             taken: Vec::new(),
             junction_scale: 1.0,
-        })
+            stop: None,
+        }
+    }
+
+    /// Prepares `leg` as the path's next element, within the path's `own` limits when given:
+    /// refused (nothing changes) if it cannot be played. With `blend`, it joins the element
+    /// before at the speed their junction allows (0 at a corner, from or into a rapid); an
+    /// element already entered is never replanned, so a junction that needs the line before
+    /// it to keep part of an axis's limits (it was entered with them whole) is a stop.
+    pub fn push(
+        &mut self,
+        leg: Block,
+        blend: bool,
+        own: Option<PathLimits>,
+    ) -> Result<(), PlayError> {
+        let format = self.format;
+        let at = self
+            .legs
+            .last()
+            .map_or_else(|| self.from.clone(), |b| b.element.to().to_vec());
+        let line = leg.line;
+        let prepared = prepare(&at, std::slice::from_ref(&leg.element))
+            .map_err(|source| PlayError::Path { line, source })?;
+        let g = &prepared.geometries()[0];
+        let physical = g.scaled(format.position_lsb);
+        let geometric = element_limits(&physical, &self.axes, f64::INFINITY)
+            .ok_or(PlayError::Still { line })?;
+        let base = Limits {
+            velocity: geometric.velocity.min(leg.feed.unwrap_or(f64::INFINITY)),
+            ..geometric
+        };
+        // The path length register: the host axis's positions (half its range, a cell per
+        // element for the fitting).
+        let most = format.physical_max(Quantity::Position) * 0.5;
+        let length = prepared.length_physical(format.position_lsb);
+        let total = self.total + length + format.position_lsb;
+        if total > most {
+            return Err(PlayError::TooLong {
+                line,
+                length: total,
+                most,
+            });
+        }
+        let frames = frames(
+            &at,
+            &leg.element,
+            g,
+            prepared.length() as f64 / 2f64.powi(FRAC_BITS as i32),
+        );
+        self.total = total;
+        self.planned.push(Planned {
+            limits: base,
+            base,
+            own,
+            cap: geometric.velocity,
+            length,
+            frames,
+            prepared,
+            junction: 0.0,
+            geometry: physical,
+            spiked: vec![false; self.axes.len()],
+        });
+        self.legs.push(leg);
+        let k = self.legs.len() - 1;
+        if k > 0 && blend && self.legs[k].feed.is_some() && self.legs[k - 1].feed.is_some() {
+            self.join(k);
+        }
+        self.relimit(k);
+        Ok(())
+    }
+
+    /// Element `k`'s junction with the one before, at speed where it allows (0: a corner).
+    /// On a line that meets another element at speed, an axis whose direction share or
+    /// curvature changes there keeps half of its acceleration and jerk for that change, as
+    /// an arc keeps half for its centripetal terms (`snapgen_plan::path::junction`).
+    fn join(&mut self, k: usize) {
+        let (before, after) = (&self.planned[k - 1].frames.1, &self.planned[k].frames.0);
+        let v = junction_speed(
+            before,
+            after,
+            &self.axes,
+            self.format.ts,
+            self.format.position_lsb,
+        );
+        if v <= 0.0 {
+            return;
+        }
+        let changes: Vec<bool> = (0..self.axes.len())
+            .map(|i| {
+                before.direction[i] != after.direction[i]
+                    || before.curvature[i] != after.curvature[i]
+            })
+            .collect();
+        let line_before = matches!(self.legs[k - 1].element, Element::Line { .. });
+        let entered = k - 1 < self.entries.len();
+        let spiked = &self.planned[k - 1].spiked;
+        if entered && line_before && changes.iter().zip(spiked).any(|(&c, &h)| c && !h) {
+            return;
+        }
+        for e in [k - 1, k] {
+            for (h, &c) in self.planned[e].spiked.iter_mut().zip(&changes) {
+                *h |= c;
+            }
+        }
+        if !entered {
+            self.relimit(k - 1);
+        }
+        self.planned[k].junction = v;
+    }
+
+    /// Element `k`'s limits: its own, a line's acceleration and jerk from the axes' halves
+    /// where a junction at speed changes them ([`Group::join`]).
+    fn relimit(&mut self, k: usize) {
+        let halved: Vec<Limits> = self
+            .axes
+            .iter()
+            .zip(&self.planned[k].spiked)
+            .map(|(l, &h)| {
+                let f = if h { 0.5 } else { 1.0 };
+                Limits {
+                    velocity: l.velocity,
+                    acceleration: l.acceleration * f,
+                    jerk: l.jerk * f,
+                }
+            })
+            .collect();
+        let line = matches!(self.legs[k].element, Element::Line { .. });
+        let p = &mut self.planned[k];
+        p.limits = p.base;
+        if line && p.spiked.contains(&true) {
+            if let Some(l) = element_limits(&p.geometry, &halved, f64::INFINITY) {
+                p.limits.acceleration = l.acceleration;
+                p.limits.jerk = l.jerk;
+            }
+        }
     }
 
     /// Where a run entering later continues one at speed, the stretch changes at the
@@ -321,8 +407,8 @@ impl<'a> Group<'a> {
 
     /// An element's acceleration, deceleration and jerk on `s`: its geometry's, within the
     /// path's own.
-    fn own_limits(&self, l: &Limits) -> (f64, f64, f64) {
-        match self.own {
+    fn own_limits(l: &Limits, own: Option<PathLimits>) -> (f64, f64, f64) {
+        match own {
             Some(o) => (
                 l.acceleration.min(o.acceleration),
                 l.acceleration.min(o.deceleration),
@@ -330,6 +416,50 @@ impl<'a> Group<'a> {
             ),
             None => (l.acceleration, l.acceleration, l.jerk),
         }
+    }
+
+    /// Element `p`'s acceleration, deceleration and jerk on `s` as its move is planned: its
+    /// own ([`Group::own_limits`]), the deceleration and jerk within a board's stop when
+    /// one is set ([`Group::for_board_stop`]).
+    fn move_limits(&self, p: &Planned) -> (f64, f64, f64) {
+        let (a, d, j) = Self::own_limits(&p.limits, p.own);
+        match self.stop {
+            Some(s) => {
+                let k = 1.0 - STOP_MARGIN;
+                (a, d.min(k * s.deceleration), j.min(k * k * s.jerk))
+            }
+            None => (a, d, j),
+        }
+    }
+
+    /// The largest controlled stop (deceleration and jerk on `s`, units/s², /s³) within every
+    /// axis's limits on every element of the path: the smallest that the elements' geometry
+    /// allows (the path's own limits are the moves', not the stop's: a stop may brake harder
+    /// than a move, within the axes).
+    pub fn stop_limits(&self) -> BoardStop {
+        let mut s = BoardStop {
+            deceleration: f64::INFINITY,
+            jerk: f64::INFINITY,
+        };
+        for p in &self.planned {
+            s.deceleration = s.deceleration.min(p.limits.acceleration);
+            s.jerk = s.jerk.min(p.limits.jerk);
+        }
+        s
+    }
+
+    /// The group for a board whose controlled stop (the group stop: the chain decelerates on
+    /// `s` by the fabric's own law, from whatever state it is in) takes [`Group::stop_limits`]:
+    /// every move decelerates and jerks within them too, with [`STOP_MARGIN`] to spare. A
+    /// stop then stays within every axis's limits on every element (no element allows less),
+    /// and, braking at once and harder than the moves, comes to rest where they would at the
+    /// latest: never past a corner or the path's end at speed, where the axes cannot follow.
+    /// Begun in a move's last ticks before such a stop, its law lands a hair past it (measured:
+    /// under 0.05 of a cell, at under 0.01 of a cell a tick): the corner is a cell's centre,
+    /// so no axis's output moves. Call it once every element has been pushed.
+    pub fn for_board_stop(mut self) -> Self {
+        self.stop = Some(self.stop_limits());
+        self
     }
 
     /// The elements' plans (limits, speed cap, length) in order.
@@ -437,7 +567,7 @@ impl<'a> Group<'a> {
                     * junction_speed(
                         &q.frames.1.stretched(f0),
                         &p.frames.0.stretched(f1),
-                        self.axes,
+                        &self.axes,
                         self.format.ts,
                         self.format.position_lsb,
                     )
@@ -451,7 +581,7 @@ impl<'a> Group<'a> {
         let mut moves: Vec<Move> = Vec::new();
         for k in first..=last {
             let p = &self.planned[k];
-            let (acceleration, deceleration, jerk) = self.own_limits(&p.limits);
+            let (acceleration, deceleration, jerk) = self.move_limits(p);
             let junction = junctions[k - first];
             let short = |length: f64, speed: f64| length < speed * self.format.ts * SHORT_TICKS;
             // Joined while the move so far is short (a long move is not slowed to a short
@@ -552,6 +682,148 @@ impl<'a> Group<'a> {
             && e.at_length.is_none_or(|l| l.is_finite() && l >= 0.0)
     }
 
+    /// The tick an override to `k` asked at `due` is taken: an override that raises the
+    /// speed while a stop on the path is still braking acts once it has come to rest (a
+    /// replan from its last ticks may swing back).
+    pub fn override_due(&self, k: f64, due: u64) -> u64 {
+        let braking = self
+            .axis
+            .timeline
+            .parts
+            .iter()
+            .find(|p| p.paused && p.start_tick <= due && due < p.end_tick());
+        match braking {
+            Some(p) if k > 0.0 => p.end_tick(),
+            _ => due,
+        }
+    }
+
+    /// MC_Halt on the path length from tick `at`: every move still to play is aborted and `s`
+    /// comes to rest on the path with `deceleration` and `jerk` (units/s², /s³), cut to the
+    /// limits of every element it may still pass (their geometry's and the path's own), so
+    /// that no axis exceeds its limits while it brakes. It never passes the path's next stop
+    /// (a corner, the end of what has entered): where it would, the moves play on as planned
+    /// to that stop (they brake there within their limits) and everything after it is
+    /// aborted. The host axis's halt command (None: the path stops at its next stop), or why
+    /// it was refused.
+    pub fn halt(
+        &mut self,
+        deceleration: f64,
+        jerk: f64,
+        at: u64,
+    ) -> Result<Option<usize>, AxisErrorId> {
+        let s = self.axis.timeline.state_at(at, &self.format).x;
+        let here = self.along(s);
+        let n = self.entries.len();
+        let first = self.bounds.partition_point(|&b| b <= here);
+        // The next stop: the end of the first element from here whose successor starts from
+        // rest, or of the last one entered.
+        let last = (first..n)
+            .find(|&k| k + 1 >= n || self.entries[k + 1] <= 0.0)
+            .unwrap_or(n.saturating_sub(1));
+        let (mut dm, mut jm) = (f64::INFINITY, f64::INFINITY);
+        for p in self.planned.iter().take(last + 1).skip(first) {
+            let (_, dd, jj) = self.move_limits(p);
+            (dm, jm) = (dm.min(dd), jm.min(jj));
+        }
+        let stop = self.bounds.get(last).copied();
+        let planned = |d: f64, j: f64| -> Result<(HostAxis, usize), AxisErrorId> {
+            let mut axis = self.axis.clone();
+            let k = axis.submit(MotionCommand::Halt {
+                deceleration: d,
+                jerk: j,
+            });
+            if let Outcome::Error(e) = &axis.commands[k].outcome {
+                return Err(e.clone());
+            }
+            let (change, refused) = axis.plan_batch(at, &[Request::Command(k)]);
+            if let Some((_, why)) = refused.into_iter().next() {
+                return Err(why.error);
+            }
+            if let Some(c) = change {
+                axis.apply(c);
+            }
+            Ok((axis, k))
+        };
+        // The farthest the path length goes on `axis`'s timeline (a halt begun braking harder
+        // than its own deceleration may pass its rest and come back).
+        let reaches = |axis: &HostAxis| {
+            let t = &axis.timeline;
+            let (_, origin) = t.origin;
+            let program = t.played(t.end_tick());
+            Trace::new(&program, origin, self.format.widths)
+                .map(|k| self.along(k.state.x))
+                .max()
+                .unwrap_or(here)
+        };
+        let Some(b) = stop else {
+            let (axis, k) = planned(deceleration, jerk)?;
+            self.axis = axis;
+            return Ok(Some(k));
+        };
+        let rests = |axis: &HostAxis| {
+            let t = &axis.timeline;
+            self.along(t.state_at(t.end_tick(), &self.format).x)
+        };
+        // As given (cut to the elements' limits), else with their whole limits; one that
+        // passes where it comes to rest and turns back is not taken.
+        for (d, j) in [(deceleration.min(dm), jerk.min(jm)), (dm, jm)] {
+            let (axis, k) = planned(d, j)?;
+            let far = reaches(&axis);
+            if far <= b && far == rests(&axis) {
+                self.axis = axis;
+                return Ok(Some(k));
+            }
+        }
+        // Up to the stop as planned, when its move plays to rest there; or the stop already
+        // planned (an earlier halt, an override of 0) when it rests before. What follows is
+        // aborted.
+        let c = self.commands[last];
+        let parts = &self.axis.timeline.parts;
+        let whole = parts.iter().rposition(|p| p.command == c).filter(|&i| {
+            let p = &parts[i];
+            !p.cut
+                && !p.paused
+                && matches!(p.goal, Goal::Position { velocity, .. } if velocity == 0.0)
+        });
+        if let Some(i) = whole {
+            self.axis.timeline.parts.truncate(i + 1);
+        } else if reaches(&self.axis) > b {
+            return Err(AxisErrorId::Planner(format!(
+                "the path cannot come to rest before its next stop {} units ahead: give a higher deceleration",
+                (b - here) as f64 / 2f64.powi(FRAC_BITS as i32) * self.format.position_lsb
+            )));
+        }
+        let skip = if whole.is_some() { c + 1 } else { 0 };
+        for rec in self.axis.commands.iter_mut().skip(skip) {
+            if rec.outcome.busy() {
+                rec.outcome = Outcome::CommandAborted;
+            }
+        }
+        Ok(None)
+    }
+
+    /// The elements pushed so far, in order.
+    pub fn blocks(&self) -> &[Block] {
+        &self.legs
+    }
+
+    /// The cells (LSB) the axes start in.
+    pub fn from(&self) -> &[i64] {
+        &self.from
+    }
+
+    /// Where the path ends so far (cells, LSB): its last element's end, or its start.
+    pub fn end(&self) -> &[i64] {
+        self.legs.last().map_or(&self.from, |b| b.element.to())
+    }
+
+    /// The outcome of the move element `k` is in, once it has entered.
+    pub fn outcome_of(&self, k: usize) -> Option<&Outcome> {
+        let c = *self.commands.get(k)?;
+        self.axis.commands.get(c).map(|r| &r.outcome)
+    }
+
     /// Plays `events` in order (each at its time, or later when its length is reached),
     /// then until the path has come to rest.
     pub fn play(&mut self, events: &[PathEvent]) {
@@ -571,18 +843,8 @@ impl<'a> Group<'a> {
                 self.taken.push(None);
                 continue;
             };
-            // An override that raises the speed while a stop on the path is still braking acts
-            // once it has come to rest (a replan from its last ticks may swing back).
-            if matches!(e.action, PathAction::Override(k) if k > 0.0) {
-                if let Some(p) = self
-                    .axis
-                    .timeline
-                    .parts
-                    .iter()
-                    .find(|p| p.paused && p.start_tick <= due && due < p.end_tick())
-                {
-                    due = p.end_tick();
-                }
+            if let PathAction::Override(k) = e.action {
+                due = self.override_due(k, due);
             }
             now = due;
             self.taken.push(Some(due));
@@ -631,7 +893,7 @@ impl<'a> Group<'a> {
     /// board, its position register), through the entered elements' rules.
     pub fn map(&self, lengths: &[i128]) -> Vec<Vec<i128>> {
         let path = self.path();
-        let origin: Vec<i128> = self.axes.iter().map(|_| raw(0)).collect();
+        let origin: Vec<i128> = self.from.iter().map(|&c| raw(c)).collect();
         lengths
             .iter()
             .map(|&s| path.at(self.along(s)).unwrap_or_else(|| origin.clone()))
@@ -685,16 +947,18 @@ impl<'a> Group<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::path::verify;
 
-    const F: Format = Format {
+    /// The tests' format: 100 µs ticks, 1 µm cells.
+    pub(in crate::path) const F: Format = Format {
         ts: 1e-4,
         position_lsb: 1e-3,
         ..snapgen_model::DEFAULT_FORMAT
     };
-    const AXIS: Limits = Limits {
+    /// The tests' axes.
+    pub(in crate::path) const AXIS: Limits = Limits {
         velocity: 250.0,
         acceleration: 5000.0,
         jerk: 2e6,
@@ -823,5 +1087,121 @@ mod tests {
             * F.position_lsb
             / F.ts;
         assert!(top <= 0.98 * 250.0 + 1e-6 && top > 200.0, "{top}");
+    }
+
+    /// The chain with a corner after it: back along X to (20, 30).
+    fn cornered(feed: f64) -> Vec<Block> {
+        let mut blocks = chain(feed);
+        blocks.push(Block {
+            line: 4,
+            element: Element::Line {
+                to: vec![20_000, 30_000],
+            },
+            feed: Some(feed),
+        });
+        blocks
+    }
+
+    /// Ticks between the stops tried (1 by hand: every tick).
+    const STRIDE: usize = 97;
+
+    /// The most a stop may carry the path length past a corner or the path's end (cells):
+    /// the fabric's stop law and the planner land differently in their last ticks. A quarter
+    /// of a cell, half the way to the corner's cell's edge (measured on every tick of this
+    /// path by hand, `STRIDE` 1: 0.048).
+    const MAX_PAST: f64 = 0.25;
+
+    /// The board's controlled stop (the fabric's law, `snapgen_model::stop`) taken after
+    /// every [`STRIDE`]th tick of the path, with the limits `stop` sets on the board: the path
+    /// to there and the stop mapped onto the axes, held against the path and each axis's
+    /// limits by the independent check, on the path and within the limits up to where it
+    /// comes to rest or passes a stop of the path (a corner, its end); past one by at most
+    /// [`MAX_PAST`] of a cell, every axis in its cell there (the corner is its centre: no
+    /// output moves). The farthest past, or the first failure.
+    fn stops(g: &Group, blocks: &[Block], stop: BoardStop) -> Result<f64, String> {
+        use crate::limits::{stop_limits, LimitSource};
+        let given = |flag, v| LimitSource {
+            flag,
+            given: Some(v),
+            peak: 0,
+        };
+        let (raw, _) = stop_limits(
+            given("deceleration", stop.deceleration),
+            given("jerk", stop.jerk),
+            &F,
+        )
+        .unwrap();
+        let one = 2f64.powi(FRAC_BITS as i32);
+        let n = g.bounds().len();
+        let rests: Vec<i128> = (0..n)
+            .filter(|&k| k + 1 == n || g.entries()[k + 1] <= 0.0)
+            .map(|k| g.bounds()[k])
+            .collect();
+        let lengths = g.lengths();
+        let mut farthest = 0.0f64;
+        for t in (0..lengths.len()).step_by(STRIDE) {
+            let at = g.axis.timeline.state_at(t as u64, &F);
+            let (after, _) = snapgen_model::stop::play(at, raw, 1_000_000);
+            let mut s: Vec<i128> = lengths[..=t].to_vec();
+            s.extend(after.iter().map(|k| k.x));
+            let why = |w: String| format!("stop after tick {t}: {w}");
+            // Where the stop passes a rest of the path, if it does.
+            let from = g.along(at.x);
+            let passed = rests
+                .iter()
+                .find(|&&b| from < b && b < g.along(s[s.len() - 1]));
+            let mut upto = s.len();
+            if let Some(&b) = passed {
+                let past = (g.along(s[s.len() - 1]) - b) as f64 / one;
+                if past > MAX_PAST {
+                    return Err(why(format!("{past} cells past a stop of the path")));
+                }
+                farthest = farthest.max(past);
+                upto = s.iter().position(|&x| g.along(x) > b).unwrap();
+                let cells = |p: &[i128]| p.iter().map(|x| x >> FRAC_BITS).collect::<Vec<_>>();
+                let there = cells(&g.map(&[b + g.start_register()])[0]);
+                if g.map(&s[upto - 1..]).iter().any(|p| cells(p) != there) {
+                    return Err(why("an axis left its cell past the stop".into()));
+                }
+            }
+            let run = crate::path::collect(g, &g.axis, blocks, s).unwrap();
+            let c = verify(&run, blocks, &[AXIS; 2], &F);
+            // Within every limit up to where it passes a stop of the path.
+            if let Some(e) = c.exceeded.filter(|e| e.tick < upto) {
+                return Err(why(format!("{e:?}")));
+            }
+            match c.deviation {
+                None | Some(snapgen_verify::path::Deviation::End { .. }) => {}
+                Some(d) => return Err(why(format!("{d:?}"))),
+            }
+        }
+        Ok(farthest)
+    }
+
+    #[test]
+    fn a_board_stop_from_any_tick_stays_on_the_path_within_every_limit() {
+        let blocks = cornered(250.0);
+        let events = [enter(0.0, None, 3)];
+        let mut g = Group::new(&blocks, &[AXIS; 2], None, &F)
+            .unwrap()
+            .for_board_stop();
+        g.play(&events);
+        let stop = g.stop_limits();
+        // Half the axes' (0.98 of it): the arc keeps half for its centripetal terms.
+        assert!((stop.deceleration - 0.49 * 5000.0).abs() < 1.0, "{stop:?}");
+        let past = stops(&g, &blocks, stop).unwrap();
+        assert!(past < MAX_PAST, "{past}");
+        // Not blind: without the moves kept within it, the same stop passes the corner (or
+        // the path's end) at speed on some tick; and a stop at the moves' largest limits (the
+        // driver's default for one axis) exceeds an axis's limits on the arc.
+        let mut free = Group::new(&blocks, &[AXIS; 2], None, &F).unwrap();
+        free.play(&events);
+        assert!(stops(&free, &blocks, stop).is_err());
+        let largest = BoardStop {
+            deceleration: 5000.0,
+            jerk: 2e6,
+        };
+        let e = stops(&g, &blocks, largest).unwrap_err();
+        assert!(e.contains("Exceeded"), "{e}");
     }
 }

@@ -11,6 +11,7 @@
 
 pub mod board;
 pub mod group;
+pub mod plcopen;
 
 use snapgen_model::{Format, Quantity, FRAC_BITS};
 use snapgen_plan::path::speed::Limits;
@@ -19,7 +20,7 @@ use snapgen_verify::path as check;
 
 use crate::axis::{AxisErrorId, HostAxis, Outcome};
 use crate::gcode::Block;
-pub use group::{Group, PathAction, PathEvent, PathLimits};
+pub use group::{BoardStop, Group, PathAction, PathEvent, PathLimits};
 
 /// What went wrong with a block.
 #[derive(Debug, thiserror::Error)]
@@ -95,6 +96,9 @@ pub struct Run {
     pub taken: Vec<Option<u64>>,
     /// Overrides refused (event index, why).
     pub refused: Vec<(usize, AxisErrorId)>,
+    /// On a board: its controlled stop (the group stop), which every move kept within
+    /// (`Group::for_board_stop`).
+    pub stop: Option<BoardStop>,
 }
 
 impl Run {
@@ -207,12 +211,24 @@ pub fn collect(
         lengths,
         taken: Vec::new(),
         refused: Vec::new(),
+        stop: None,
     })
 }
 
 /// Holds `run` against the path of `blocks` and the `axes`' limits (module documentation).
 pub fn verify(run: &Run, blocks: &[Block], axes: &[Limits], format: &Format) -> Checked {
-    let mut at = vec![0i128; axes.len()];
+    verify_from(run, blocks, &vec![0; axes.len()], axes, format)
+}
+
+/// [`verify`] for a path whose axes start in the cells `from` (LSB).
+pub fn verify_from(
+    run: &Run,
+    blocks: &[Block],
+    from: &[i64],
+    axes: &[Limits],
+    format: &Format,
+) -> Checked {
+    let mut at: Vec<i128> = from.iter().map(|&x| x.into()).collect();
     let mut path = Vec::new();
     for b in &blocks[..run.blocks.len()] {
         let to: Vec<i128> = b.element.to().iter().map(|&x| x.into()).collect();

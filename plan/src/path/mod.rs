@@ -103,6 +103,7 @@ pub enum PathError {
 }
 
 /// A path measured, ready to be fitted onto a chain's move.
+#[derive(Clone)]
 pub struct Prepared {
     start: Vec<i64>,
     drafts: Vec<Draft>,
@@ -141,6 +142,7 @@ fn ratio(a: i128, shift: u32, b: i128) -> i128 {
 }
 
 /// An element's geometry before the lengths are stretched.
+#[derive(Clone)]
 enum Draft {
     Line {
         to: Vec<i128>,
