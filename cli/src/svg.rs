@@ -255,33 +255,50 @@ pub fn write_path_svg(
     head.titled(title, ("sans-serif", 20))?;
     let (top, rest) = body.split_vertically(500);
     let (rest, bottom) = rest.split_vertically(900);
-    // The path in the XY plane.
+    // The path in the XY plane, and in the ZX and YZ planes when Z moves.
     let step = (trace.len() / 20_000).max(1);
-    let xy: Vec<(f64, f64)> = trace
+    let coordinate = |p: &Vec<i128>, i: usize| mm(p.get(i).copied().unwrap_or(half));
+    let z_moves = axes > 2 && trace.iter().any(|p| p[2] != trace[0][2]);
+    let planes: &[(usize, usize, &str)] = if z_moves {
+        &[(0, 1, "XY"), (0, 2, "XZ"), (1, 2, "YZ")]
+    } else {
+        &[(0, 1, "XY")]
+    };
+    let names_of = ["X", "Y", "Z"];
+    for (&(h, v, name), area) in planes
         .iter()
-        .step_by(step)
-        .chain(trace.last())
-        .map(|p| (mm(p[0]), mm(p.get(1).copied().unwrap_or(half))))
-        .collect();
-    let (x_lo, x_hi) = xy
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-            (l.min(p.0), h.max(p.0))
-        });
-    let (y_lo, y_hi) = xy
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-            (l.min(p.1), h.max(p.1))
-        });
-    let pad = ((x_hi - x_lo).max(y_hi - y_lo) * 0.05).max(1e-9);
-    let mut chart = ChartBuilder::on(&top)
-        .margin(8)
-        .x_label_area_size(30)
-        .y_label_area_size(60)
-        .caption("path, XY plane (mm)", ("sans-serif", 16))
-        .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))?;
-    chart.configure_mesh().x_desc("X").y_desc("Y").draw()?;
-    chart.draw_series(LineSeries::new(xy, &BLUE))?;
+        .zip(top.split_evenly((1, planes.len())).iter())
+    {
+        let points: Vec<(f64, f64)> = trace
+            .iter()
+            .step_by(step)
+            .chain(trace.last())
+            .map(|p| (coordinate(p, h), coordinate(p, v)))
+            .collect();
+        let span = |f: fn(&(f64, f64)) -> f64| {
+            points
+                .iter()
+                .map(f)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                    (l.min(x), h.max(x))
+                })
+        };
+        let (x_lo, x_hi) = span(|p| p.0);
+        let (y_lo, y_hi) = span(|p| p.1);
+        let pad = ((x_hi - x_lo).max(y_hi - y_lo) * 0.05).max(1e-9);
+        let mut chart = ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(60)
+            .caption(format!("path, {name} plane (mm)"), ("sans-serif", 16))
+            .build_cartesian_2d((x_lo - pad)..(x_hi + pad), (y_lo - pad)..(y_hi + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc(names_of[h])
+            .y_desc(names_of[v])
+            .draw()?;
+        chart.draw_series(LineSeries::new(points, &BLUE))?;
+    }
     let t_end = (n.max(2) - 1) as f64 * format.ts;
     let names = ["velocity (mm/s)", "acceleration (mm/s^2)", "jerk (mm/s^3)"];
     let colors = [&RED, &GREEN, &BLUE];

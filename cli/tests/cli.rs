@@ -617,6 +617,8 @@ fn path_plays_the_example_part_and_refuses_bad_gcode() {
     );
     let picture = std::fs::read_to_string(&svg).unwrap();
     assert!(picture.contains("path, XY plane") && picture.contains("jerk (mm/s^3)"));
+    // The part's Z moves: its ZX and YZ views too.
+    assert!(picture.contains("path, XZ plane") && picture.contains("path, YZ plane"));
     assert!(picture.contains("distance from the programmed path"));
     assert!(text.contains("farthest from the programmed path"), "{text}");
     let xyz = path_rows(&csv).pop().unwrap();

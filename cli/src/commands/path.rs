@@ -4,8 +4,8 @@
 //! stopped exactly, a feed override at given times (`--override K@MS`). Checked from the axes'
 //! positions alone: on the path (lines 1 LSB on every axis, arcs 2) and within every axis's
 //! limits on every tick (`snapgen_host::path`). Prints each block's outcome (`--json`: one
-//! object); `--csv` writes the per-tick trace, `--svg` the path in the XY plane and each axis's
-//! velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read
+//! object); `--csv` writes the per-tick trace, `--svg` the path in the XY plane (XZ and YZ
+//! too when Z moves) and each axis's velocity, acceleration and jerk. Exit 1 when the check fails, 2 for a program it cannot read
 //! or play.
 //!
 //! `--board model|fabric` and `--port` run the path length on a board (its Ts read from it),
@@ -96,8 +96,8 @@ pub struct Args {
     /// Write the per-tick trace (tick, time, X, Y, Z in mm) to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// Draw the path in the XY plane and each axis's velocity, acceleration and jerk against
-    /// time into this SVG file.
+    /// Draw the path in the XY plane (XZ and YZ too when Z moves) and each axis's velocity,
+    /// acceleration and jerk against time into this SVG file.
     #[arg(long)]
     svg: Option<PathBuf>,
     /// Print one JSON object instead of the table: each block (line, kind, length, limits,
