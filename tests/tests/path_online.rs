@@ -10,7 +10,9 @@
 use proptest::prelude::*;
 use snapgen_host::axis::Outcome;
 use snapgen_host::gcode::Block;
-use snapgen_host::path::{play_events, verify, PathAction, PathEvent};
+use snapgen_host::path::{
+    play_events, verify, verify_stop, Group, PathAction, PathEvent, STOP_PAST_MAX,
+};
 use snapgen_model::{Format, DEFAULT_FORMAT, FRAC_BITS};
 use snapgen_plan::path::speed::Limits;
 use snapgen_plan::path::Element;
@@ -169,6 +171,60 @@ proptest! {
         let end = run.end_cells();
         let want: Vec<i128> = blocks.last().unwrap().element.to().iter().map(|&x| x.into()).collect();
         prop_assert_eq!(end, want);
+    }
+}
+
+/// The direction (rad) the last of `blocks` ends in (from the origin).
+fn heading_at_end(blocks: &[Block]) -> f64 {
+    let from = match blocks.len() {
+        0 | 1 => vec![0, 0],
+        n => blocks[n - 2].element.to().to_vec(),
+    };
+    match &blocks.last().unwrap().element {
+        Element::Line { to } => ((to[1] - from[1]) as f64).atan2((to[0] - from[0]) as f64),
+        Element::Arc {
+            centre, ccw, to, ..
+        } => {
+            let radial = ((to[1] - centre[1]) as f64).atan2((to[0] - centre[0]) as f64);
+            radial + if *ccw { 1.0 } else { -1.0 } * std::f64::consts::FRAC_PI_2
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// On a board (its controlled stop set from the path, every move within it:
+    /// `Group::for_board_stop`), a stop taken at random ticks of a random tangent chain with a
+    /// corner after it stays on the path within every axis's limits and comes to rest before
+    /// the corner or the path's end (a hair past at most, every axis inside the cell there).
+    #[test]
+    fn a_board_stop_at_any_tick_of_a_chain_with_a_corner_stays_on_the_path(
+        draws in prop::collection::vec(draw(), 1..5),
+        feed in 20.0f64..200.0,
+        axes in prop::array::uniform2(axis()),
+        corner in 0.3f64..2.8,
+        back in 0.5f64..20.0,
+        at in prop::collection::vec(0.0f64..1.0, 12),
+    ) {
+        let mut blocks = chain(&draws, feed);
+        // A line turning `corner` rad off the chain's heading at its end: a corner.
+        let end = blocks.last().unwrap().element.to().to_vec();
+        let heading = heading_at_end(&blocks) + corner;
+        let (s, c) = heading.sin_cos();
+        let to = vec![end[0] + (c * back * 1e3).round() as i64, end[1] + (s * back * 1e3).round() as i64];
+        blocks.push(Block { line: blocks.len() + 1, element: Element::Line { to }, feed: Some(feed) });
+        let mut g = Group::new(&blocks, &axes, None, &F).unwrap().for_board_stop();
+        g.play(&[PathEvent { at_ms: 0.0, at_length: None, action: PathAction::Enter(blocks.len() - 1) }]);
+        let stop = g.stop_limits();
+        let ticks = g.lengths().len() as f64;
+        for f in at {
+            let t = (f * ticks) as u64;
+            let past = verify_stop(&g, &blocks, &axes, stop, t);
+            prop_assert!(past.is_ok(), "stop after tick {}: {:?}", t, past);
+            let past = past.unwrap();
+            prop_assert!(past <= STOP_PAST_MAX);
+        }
     }
 }
 

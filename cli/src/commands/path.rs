@@ -24,6 +24,7 @@ use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::PlayError as ScriptError;
 use snapgen_host::path::board::{play_on_board_with, BoardError};
 use snapgen_host::path::group::MAX_EVENT_MS;
+use snapgen_host::path::group::STOP_MARGIN;
 use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::Session;
@@ -324,8 +325,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
         if let Some(s) = run.stop {
             println!(
-                "the board's controlled stop (a group stop on the path): {:.1} mm/s², {:.0} mm/s³, within every axis on every element; every move within them",
-                s.deceleration, s.jerk
+                "the board's controlled stop (a group stop on the path): {:.1} mm/s², {:.0} mm/s³, within every axis on every element; every move within {:.0} % of them",
+                s.deceleration,
+                s.jerk,
+                100.0 * (1.0 - STOP_MARGIN)
             );
         }
         println!("farthest from the programmed path: {farthest:.3e} LSB");

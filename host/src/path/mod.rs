@@ -318,6 +318,105 @@ pub fn verify_from(
     }
 }
 
+/// The most a board's stop may carry the path length past a corner or the path's end (cells):
+/// the fabric's stop law and the planner land differently in their last ticks (measured:
+/// docs/PATH.md). Half a cell: the corner is a cell centre, so no axis's output cell changes
+/// (which [`verify_stop`] checks on its own).
+pub const STOP_PAST_MAX: f64 = 0.5;
+
+/// Why a board's stop failed its check ([`verify_stop`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StopFault {
+    /// It left the path.
+    #[error("off the path: {0:?}")]
+    Off(check::Deviation),
+    /// An axis's limit exceeded before it passed a rest of the path.
+    #[error("an axis's limit exceeded: {0:?}")]
+    Exceeded(check::Exceeded),
+    /// It came to rest too far past a corner or the path's end.
+    #[error("{past} cells past a corner or the path's end (at most {STOP_PAST_MAX})")]
+    Past {
+        /// How far (cells of the path length).
+        past: f64,
+    },
+    /// Past one, an axis left the cell of that corner.
+    #[error("past a corner or the path's end, an axis left its cell")]
+    LeftCell,
+    /// The stop's limits cannot be given to a board, or the path was not played.
+    #[error("{0}")]
+    Setup(String),
+}
+
+/// A board's controlled stop, with limits `stop` (as the board takes them: `crate::limits`),
+/// taken after tick `t` of `g`'s path (the fabric's law played from the exact state the
+/// path's length is in: `snapgen_model::stop::play`), held against the path of `blocks` and
+/// the `axes`' limits by the independent check: on the path and within every limit up to where
+/// it comes to rest or passes a rest of the path (a corner, the end of what has entered); past
+/// one by at most [`STOP_PAST_MAX`] of a cell, every axis in the cell of that rest. How far past
+/// one it came (cells; 0 if none), or why it failed.
+pub fn verify_stop(
+    g: &Group,
+    blocks: &[Block],
+    axes: &[Limits],
+    stop: BoardStop,
+    t: u64,
+) -> Result<f64, StopFault> {
+    use crate::limits::{stop_limits, LimitSource};
+    let format = g.format();
+    let given = |flag, v| LimitSource {
+        flag,
+        given: Some(v),
+        peak: 0,
+    };
+    let (raw, _) = stop_limits(
+        given("deceleration", stop.deceleration),
+        given("jerk", stop.jerk),
+        &format,
+    )
+    .map_err(|e| StopFault::Setup(e.to_string()))?;
+    let one = 2f64.powi(FRAC_BITS as i32);
+    let (bounds, entries) = (g.bounds(), g.entries());
+    let n = bounds.len();
+    let rests: Vec<i128> = (0..n)
+        .filter(|&k| k + 1 == n || entries[k + 1] <= 0.0)
+        .map(|k| bounds[k])
+        .collect();
+    let lengths = g.lengths();
+    let t = (t as usize).min(lengths.len().saturating_sub(1));
+    let at = g.axis.timeline.state_at(t as u64, &format);
+    let (after, _) = snapgen_model::stop::play(at, raw, 100_000_000);
+    let mut s: Vec<i128> = lengths[..=t].to_vec();
+    s.extend(after.iter().map(|k| k.x));
+    let last = g.along(s[s.len() - 1]);
+    let from = g.along(at.x);
+    let mut upto = s.len();
+    let mut past = 0.0;
+    if let Some(&b) = rests.iter().find(|&&b| from < b && b < last) {
+        past = (last - b) as f64 / one;
+        if past > STOP_PAST_MAX {
+            return Err(StopFault::Past { past });
+        }
+        upto = s.iter().position(|&x| g.along(x) > b).unwrap_or(s.len());
+        let cells = |p: &[i128]| p.iter().map(|x| x >> FRAC_BITS).collect::<Vec<_>>();
+        let there = cells(&g.map(&[b + g.start_register()])[0]);
+        if g.map(&s[upto.saturating_sub(1)..])
+            .iter()
+            .any(|p| cells(p) != there)
+        {
+            return Err(StopFault::LeftCell);
+        }
+    }
+    let run = collect(g, &g.axis, blocks, s).map_err(|e| StopFault::Setup(e.to_string()))?;
+    let c = verify_from(&run, blocks, g.from(), axes, &format);
+    if let Some(e) = c.exceeded.filter(|e| e.tick < upto) {
+        return Err(StopFault::Exceeded(e));
+    }
+    match c.deviation {
+        None | Some(check::Deviation::End { .. }) => Ok(past),
+        Some(d) => Err(StopFault::Off(d)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
