@@ -13,9 +13,10 @@
 //!   every junction a step passes must lie within that step's box widened by the bound: an
 //!   element passed over within one tick, never a detour skipped nor a full turn cut short; a
 //!   point within the bound of two elements near their junction is read both ways until the
-//!   trace decides),
-//!   and the trace ends exactly on the last element's end point. A line's bound is per axis ([`line`]: a point of the exact segment
-//!   exists from which every axis is within `b`), an arc's is radial in its plane and per axis
+//!   trace decides), and the trace ends exactly on the last element's end point, followed onto
+//!   the last element (a path that passes its end point earlier is not done there). A
+//!   line's bound is per axis ([`line`]: a point of the exact segment exists from which every
+//!   axis is within `b`), an arc's is radial in its plane and per axis
 //!   off it ([`arc`]). Lines and the radial and angular tests of arcs are exact (integer
 //!   arithmetic of any size); only a helix's axial test uses floating point, with margins for
 //!   its rounding counted against the trace (it may refuse a point within the bound by a
@@ -337,9 +338,13 @@ pub fn follow(
         }
         ways = next;
     }
-    let end = path[path.len() - 1].to();
+    let last = path.len() - 1;
+    let end = path[last].to();
+    // The trace ends on a reading of the last element (a path that passes its end point
+    // earlier is not done there).
+    let done = ways.iter().any(|&(at, _)| at == last);
     match trace.last() {
-        Some(p) if p.as_slice() == end => Ok(Ok(Followed { entered })),
+        Some(p) if p.as_slice() == end && done => Ok(Ok(Followed { entered })),
         last => Ok(Err(Deviation::End {
             point: last.cloned().unwrap_or_default(),
             end: end.to_vec(),
@@ -478,6 +483,31 @@ mod tests {
         let mut skip = trace.clone();
         skip.drain(99..140);
         assert!(follow(&path, &skip, Bounds::all(1)).unwrap().is_ok());
+    }
+
+    #[test]
+    fn a_trace_ends_only_on_the_last_elements_end() {
+        // Out along x, up and back down to (10, 0): the path ends where its first line does.
+        let line = |from: [i128; 2], to: [i128; 2]| {
+            Element::Line(Line {
+                from: from.to_vec(),
+                to: to.to_vec(),
+            })
+        };
+        let path = [
+            line([0, 0], [10, 0]),
+            line([10, 0], [10, 10]),
+            line([10, 10], [10, 0]),
+        ];
+        let short: Vec<Vec<i128>> = (0..=10).map(|x| vec![x, 0]).collect();
+        assert!(matches!(
+            follow(&path, &short, Bounds::all(1)).unwrap(),
+            Err(Deviation::End { .. })
+        ));
+        let mut whole = short.clone();
+        whole.extend((1..=10).map(|y| vec![10, y]));
+        whole.extend((0..10).rev().map(|y| vec![10, y]));
+        assert!(follow(&path, &whole, Bounds::all(1)).unwrap().is_ok());
     }
 
     #[test]
