@@ -720,7 +720,7 @@ impl Group {
         // The next stop: the end of the first element from here whose successor starts from
         // rest, or of the last one entered.
         let last = (first..n)
-            .find(|&k| k + 1 >= n || self.entries[k + 1] <= 0.0)
+            .find(|&k| self.rests_after(k))
             .unwrap_or(n.saturating_sub(1));
         let (mut dm, mut jm) = (f64::INFINITY, f64::INFINITY);
         for p in self.planned.iter().take(last + 1).skip(first) {
@@ -807,6 +807,12 @@ impl Group {
     /// The board's format the group plans in.
     pub fn format(&self) -> Format {
         self.format
+    }
+
+    /// Whether the path comes to rest at the end of entered element `k`: the last one
+    /// entered, or one whose successor starts from rest (a corner, a rapid).
+    pub fn rests_after(&self, k: usize) -> bool {
+        k + 1 >= self.entries.len() || self.entries[k + 1] <= 0.0
     }
 
     /// The elements pushed so far, in order.

@@ -375,10 +375,9 @@ pub fn verify_stop(
     )
     .map_err(|e| StopFault::Setup(e.to_string()))?;
     let one = 2f64.powi(FRAC_BITS as i32);
-    let (bounds, entries) = (g.bounds(), g.entries());
-    let n = bounds.len();
-    let rests: Vec<i128> = (0..n)
-        .filter(|&k| k + 1 == n || entries[k + 1] <= 0.0)
+    let bounds = g.bounds();
+    let rests: Vec<i128> = (0..bounds.len())
+        .filter(|&k| g.rests_after(k))
         .map(|k| bounds[k])
         .collect();
     let lengths = g.lengths();

@@ -485,15 +485,17 @@ mod tests {
         assert!(follow(&path, &skip, Bounds::all(1)).unwrap().is_ok());
     }
 
+    /// A line in the plane.
+    fn line(from: [i128; 2], to: [i128; 2]) -> Element {
+        Element::Line(Line {
+            from: from.to_vec(),
+            to: to.to_vec(),
+        })
+    }
+
     #[test]
     fn a_trace_ends_only_on_the_last_elements_end() {
         // Out along x, up and back down to (10, 0): the path ends where its first line does.
-        let line = |from: [i128; 2], to: [i128; 2]| {
-            Element::Line(Line {
-                from: from.to_vec(),
-                to: to.to_vec(),
-            })
-        };
         let path = [
             line([0, 0], [10, 0]),
             line([10, 0], [10, 10]),
@@ -514,12 +516,6 @@ mod tests {
     fn a_detour_or_a_turn_cannot_be_skipped_and_the_start_is_the_path_s() {
         // Out along x, up 10 in y and back down (a retract), then on along x: a trace
         // straight along x passes the retract's ends but not the retract itself.
-        let line = |from: [i128; 2], to: [i128; 2]| {
-            Element::Line(Line {
-                from: from.to_vec(),
-                to: to.to_vec(),
-            })
-        };
         let path = [
             line([0, 0], [10, 0]),
             line([10, 0], [10, 10]),
