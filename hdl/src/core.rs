@@ -73,8 +73,9 @@ impl Logic for MotionCore {
         self.ticks_next.next = self.ticks_reg.q.val() + self.ticks_one.val();
         self.divider.reset.next = self.reset.val();
         self.divider.divisor.next = self.tick_div.val();
-        // A due tick waits while the stop unit computes the next tick's snap.
-        self.divider.hold.next = self.stop_unit.computing.val();
+        // A due tick waits while the stop unit computes the next tick's snap (the tick is a
+        // register: it is told what the unit does after this edge).
+        self.divider.hold_next.next = self.stop_unit.computing_next.val();
         // The stop is taken on the first tick after the unit has prepared it.
         self.engage.next = self.divider.tick.val()
             & self.stop_unit.armed.val()

@@ -75,6 +75,8 @@ pub struct StopUnit {
     pub armed: Signal<Out, Bit>,
     /// The stop runs and the unit is computing: the next tick must wait.
     pub computing: Signal<Out, Bit>,
+    /// `computing` after this clock's edge (for the tick divider's register).
+    pub computing_next: Signal<Out, Bit>,
     /// `snap` is the next tick's.
     pub ready: Signal<Out, Bit>,
     /// The next tick's snap.
@@ -85,7 +87,7 @@ pub struct StopUnit {
     pub heading_pos: Signal<Out, Bit>,
     /// The axis heads backward: ... negative.
     pub heading_neg: Signal<Out, Bit>,
-    /// The chain is at rest: v = a = j = 0 (combinational).
+    /// The chain was at rest on the last clock: v = a = j = 0 (registered).
     pub at_rest: Signal<Out, Bit>,
     _sim: SimState,
 }
@@ -98,6 +100,7 @@ struct SimState {
     jerk_limit: u128,
     accel_limit: u128,
     heading: i8,
+    at_rest: bool,
 }
 
 const IDLE: u8 = 0;
@@ -116,6 +119,7 @@ impl Logic for StopUnit {
                 to_i128(self.a.val()),
                 to_i128(self.j.val()),
             );
+            s.at_rest = v == 0 && a == 0 && j == 0;
             s.heading = if v != 0 {
                 v.signum()
             } else if a != 0 {
@@ -168,12 +172,20 @@ impl Logic for StopUnit {
         let s = &self._sim;
         self.heading_pos.next = s.heading > 0;
         self.heading_neg.next = s.heading < 0;
-        self.at_rest.next = self.v.val() == Bits::<D_BITS>::default()
-            && self.a.val() == Bits::<D_BITS>::default()
-            && self.j.val() == Bits::<D_BITS>::default();
+        self.at_rest.next = s.at_rest;
         self.active.next = s.phase != IDLE;
         self.armed.next = s.phase == ARMED;
         self.computing.next = s.phase == RUN;
+        let p = microprogram();
+        let halts = p
+            .code
+            .get(s.engine.pc)
+            .is_none_or(|i| matches!(i, Instr::Halt));
+        self.computing_next.next = !self.reset.val()
+            && !self.cancel.val()
+            && ((s.phase == ARMED && self.engage.val())
+                || (s.phase == READY && self.tick.val())
+                || (s.phase == RUN && !halts));
         self.ready.next = s.phase == READY;
         self.snap.next = from_u128(s.engine.snap);
         self.over.next = s.engine.flags >> (Flag::Exceeds as u32) & 1 == 1;
@@ -183,6 +195,7 @@ impl Logic for StopUnit {
         self.active.connect();
         self.armed.connect();
         self.computing.connect();
+        self.computing_next.connect();
         self.ready.connect();
         self.snap.connect();
         self.over.connect();

@@ -1,7 +1,12 @@
 //! The trajectory tick: one clock-wide pulse every `divisor + 1` clocks, so the fabric clock
 //! (125 MHz on the Zybo) and the tick `Ts` are independent. `divisor = 0` ticks on every clock.
-//! While `hold` is high (the stop unit is computing the next tick's snap) a due tick waits and
-//! the count runs on; the tick comes on the first clock without `hold`.
+//! While the stop unit computes the next tick's snap a due tick waits and the count runs on;
+//! the tick comes on the first clock it does not compute.
+//!
+//! The tick is a register (it fans out to every register of the core): on each edge it takes
+//! what the next clock's tick is, from the count after the edge, the divisor before it and
+//! `hold_next`, the stop unit's "computing" after the edge. So a new divisor counts from the
+//! clock after it is written (`snapgen_model::CoreModel` does the same).
 
 use rust_hdl::prelude::*;
 
@@ -16,11 +21,13 @@ pub struct TickDivider {
     pub reset: Signal<In, Bit>,
     /// Clocks per tick minus one.
     pub divisor: Signal<In, Bits<TICK_BITS>>,
-    /// Hold a due tick.
-    pub hold: Signal<In, Bit>,
-    /// High for one clock every `divisor + 1` clocks.
+    /// Hold a due tick on the next clock (the stop unit computes then).
+    pub hold_next: Signal<In, Bit>,
+    /// High for one clock every `divisor + 1` clocks (registered).
     pub tick: Signal<Out, Bit>,
     counter: DFF<Bits<TICK_BITS>>,
+    tick_reg: DFF<Bit>,
+    count_next: Signal<Local, Bits<TICK_BITS>>,
     zero: Constant<Bits<TICK_BITS>>,
     one: Constant<Bits<TICK_BITS>>,
 }
@@ -31,9 +38,11 @@ impl Default for TickDivider {
             clock: Default::default(),
             reset: Default::default(),
             divisor: Default::default(),
-            hold: Default::default(),
+            hold_next: Default::default(),
             tick: Default::default(),
             counter: Default::default(),
+            tick_reg: Default::default(),
+            count_next: Default::default(),
             zero: Constant::new(0.into()),
             one: Constant::new(1.into()),
         }
@@ -43,14 +52,17 @@ impl Default for TickDivider {
 impl Logic for TickDivider {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, counter);
-        // `>=` rather than `==`: lowering the divisor mid-count never waits for a wrap.
-        self.tick.next = (self.counter.q.val() >= self.divisor.val()) & !self.hold.val();
-        if self.reset.val() | self.tick.val() {
-            self.counter.d.next = self.zero.val();
+        dff_setup!(self, clock, counter, tick_reg);
+        self.tick.next = self.tick_reg.q.val();
+        if self.reset.val() | self.tick_reg.q.val() {
+            self.count_next.next = self.zero.val();
         } else {
-            self.counter.d.next = self.counter.q.val() + self.one.val();
+            self.count_next.next = self.counter.q.val() + self.one.val();
         }
+        self.counter.d.next = self.count_next.val();
+        // `>=` rather than `==`: lowering the divisor mid-count never waits for a wrap.
+        self.tick_reg.d.next =
+            (self.count_next.val() >= self.divisor.val()) & !self.hold_next.val();
     }
 }
 

@@ -171,7 +171,9 @@ end
 wire retry = has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
    && (crc == last_crc_q);
 wire expired = (watchdog_ms_q != {WATCHDOG_MS_BITS{1'b0}}) && (watchdog_count_q >= watchdog_ms_q);
-wire settling = start_q || stop_q || swap_q;     // a start, stop or swap the core takes now
+// A start, stop or swap the core takes now, or the chain driven on the last clock (the core's
+// at_rest is a register: it tells where the last tick left the chain a clock later).
+wire settling = start_q || stop_q || swap_q || was_driven_q;
 wire driven = busy || stopping;
 
 // ---- Next state, in the model's order ------------------------------------------------------

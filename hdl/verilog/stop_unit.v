@@ -46,17 +46,32 @@ reg carry = 1'b0;                        // between words: the adder's carry,
 reg shift_bit = 1'b0;                    // the bit a shift moves across,
 reg zero_acc = 1'b0;                     // the result is zero so far,
 reg fill = 1'b0;                         // the sign of a one-word right shift's source
-reg [FLAG_COUNT-1:0] flags = {FLAG_COUNT{1'b0}};
+// The flags. An instruction's flag write is applied a clock after its last step (`flag_pend`:
+// the adder's result and the flag's combination are not in one clock's path); `flags`, what
+// every reader sees, is the register with the pending write applied: the same value on every
+// clock as if it had been written at once.
+reg [FLAG_COUNT-1:0] flags_q = {FLAG_COUNT{1'b0}};
+reg flag_pend = 1'b0;                    // a flag write is pending: flag_src_q into flag_we_q
+reg flag_src_q = 1'b0;
+reg [FLAG_COUNT-1:0] flag_we_q = {FLAG_COUNT{1'b0}};
+reg flag_and_q = 1'b0, flag_or_q = 1'b0;
+wire [FLAG_COUNT-1:0] flag_new = flag_and_q ? (flags_q & {FLAG_COUNT{flag_src_q}})
+   : flag_or_q ? (flags_q | {FLAG_COUNT{flag_src_q}}) : {FLAG_COUNT{flag_src_q}};
+wire [FLAG_COUNT-1:0] flags = flag_pend ? ((flags_q & ~flag_we_q) | (flag_we_q & flag_new))
+   : flags_q;
 reg [D_BITS-1:0] jlim = {D_BITS{1'b0}};     // the limits, latched on the request
 reg [D_BITS-1:0] alim = {D_BITS{1'b0}};
 reg [D_BITS-1:0] snap_reg = {D_BITS{1'b0}};
-reg [47:0] rf [0:63];                    // 16 registers x 4 word slots (3 used), LUT-RAM
+(* ram_style = "distributed" *)  // LUT-RAM: a block RAM's read (5.6 ns on an ECP5) is in the adder's path
+reg [47:0] rf [0:63];                    // 16 registers x 4 word slots (3 used)
 integer rf_i;
 initial for (rf_i = 0; rf_i < 64; rf_i = rf_i + 1) rf[rf_i] = 48'd0;
 
 // ---- The microprogram (snapgen_model::stop::program) -----------------------------------------
+// In logic, not block RAM: a block RAM's clock-to-out (5.6 ns on an ECP5) would start the
+// engine's operand read.
 function automatic [{{ROM_TOP}}:0] rom(input [6:0] addr);
-   case (addr)
+   (* rom_style = "logic" *) case (addr)
 //@ rom_cases
    endcase
 endfunction
@@ -79,7 +94,6 @@ always @(posedge clock) begin : engine
    reg first, last, shift_out, a_zero, a_wide, f_src, write;
    reg [47:0] a_op, b_op, result;
    reg [48:0] sum;
-   reg [FLAG_COUNT-1:0] f_new;
    reg [31:0] conds;
    reg [6:0] pc_next;
    reg fetch;                            // load pc and ir (with ROM[pc_next])
@@ -91,7 +105,6 @@ always @(posedge clock) begin : engine
    // only while the engine runs.
    {shr, kr, ak, ke, ak_wide, a_below, a_above, a_ext, a_raw} = {{LOCALS_A}}'d0;
    {first, last, shift_out, a_zero, a_wide, f_src, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
-   f_new = {FLAG_COUNT{1'b0}};
    conds = 32'd0;
    pc_next = pc;
    fetch = 1'b0;
@@ -129,8 +142,6 @@ always @(posedge clock) begin : engine
       a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
       f_src = (src[0] & result[47]) | (src[1] & ~result[47]) | (src[2] & a_zero)
          | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
-      f_new = flag_and ? (flags & {FLAG_COUNT{f_src}})
-         : flag_or ? (flags | {FLAG_COUNT{f_src}}) : {FLAG_COUNT{f_src}};
       write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
       // The next instruction.
       if (i_kind == K_LOOP) pc_next = pc + 7'd1;
@@ -139,9 +150,11 @@ always @(posedge clock) begin : engine
       fetch = 1'b1;
       if (write && i_write) rf[{i_dst, ke}] <= result;
    end
+   flags_q <= flags;
+   flag_pend <= 1'b0;
    if (reset) begin
       phase <= PH_IDLE;
-      flags <= {FLAG_COUNT{1'b0}};
+      flags_q <= {FLAG_COUNT{1'b0}};
    end else if (cancel) begin
       phase <= PH_IDLE;
    end else begin
@@ -209,7 +222,13 @@ always @(posedge clock) begin : engine
                default: snap_reg[D_BITS-1:96] <= result[D_BITS-97:0];
                endcase
             end
-            if (write && last) flags <= (flags & ~flag_we) | (flag_we & f_new);
+            if (write && last) begin
+               flag_pend <= 1'b1;
+               flag_src_q <= f_src;
+               flag_we_q <= flag_we;
+               flag_and_q <= flag_and;
+               flag_or_q <= flag_or;
+            end
             if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
             step <= last ? 2'd0 : step + 2'd1;
          end
@@ -231,13 +250,17 @@ always @(posedge clock) begin : engine
    end
 end
 
-// ---- Heading (for the limit switches), registered: the sign of v, else a, else j ---------------
+// ---- Heading (for the limit switches) and at rest, registered: the sign of v, else a, else j --
 wire v_zero = v == {D_BITS{1'b0}};
 wire a_zero = a == {D_BITS{1'b0}};
 wire j_zero = j == {D_BITS{1'b0}};
 reg heading_pos_q = 1'b0;
 reg heading_neg_q = 1'b0;
+// At rest (v = a = j = 0), registered: a 3 x 104-bit zero test is too long to feed the
+// executor's decisions in the same clock.
+reg at_rest_q = 1'b0;
 always @(posedge clock) begin
+   at_rest_q <= v_zero && a_zero && j_zero;
    heading_pos_q <= !v_zero ? ~v[D_BITS-1] : (!a_zero ? ~a[D_BITS-1] : (~j[D_BITS-1] && !j_zero));
    heading_neg_q <= !v_zero ? v[D_BITS-1] : (!a_zero ? a[D_BITS-1] : j[D_BITS-1]);
 end
@@ -246,10 +269,13 @@ always @(*) begin
    active = phase != PH_IDLE;
    armed = phase == PH_ARMED;
    computing = phase == PH_RUN;
+   // The phase after this edge is RUN (the tick divider's register is told it).
+   computing_next = !reset && !cancel && (((phase == PH_ARMED) && engage)
+      || ((phase == PH_READY) && tick) || ((phase == PH_RUN) && (i_kind != K_HALT)));
    ready = phase == PH_READY;
    snap = snap_reg;
    over = flags[F_EXCEEDS];
    heading_pos = heading_pos_q;
    heading_neg = heading_neg_q;
-   at_rest = v_zero && a_zero && j_zero;
+   at_rest = at_rest_q;
 end

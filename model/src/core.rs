@@ -4,8 +4,10 @@
 //! model and the Verilated core with the same inputs and compares every output on every clock.
 //!
 //! Per clock, from the values before the edge:
-//! * `tick = divider ≥ tick_div` unless a stop is computing its next snap (the tick then waits:
-//!   the divider keeps counting and the tick comes on the first clock the snap is ready).
+//! * `tick` is a register: after each edge it is `divider ≥ tick_div` (the divider after the
+//!   edge, `tick_div` before it) unless the stop unit is computing its next snap after the
+//!   edge (the tick then waits: the divider keeps counting and the tick comes on the first
+//!   clock the snap is ready). A new `tick_div` counts from the clock after it is written.
 //! * The sequencer reads the *active* bank while busy and the *standby* bank while idle, at
 //!   address `index + 1` (busy) or 0 (idle).
 //! * A start (accepted only while idle, not stopping, and without a pending stop, abort or
@@ -29,9 +31,9 @@
 //!   rest and no program playing).
 //! * `tick_count` counts the ticks since the last start while a program plays or a stop runs;
 //!   `ticks` counts every tick since reset (64 bits).
-//! * `at_rest` is v = a = j = 0; `heading_pos`/`heading_neg` (registered) give the sign of the
-//!   first non-zero of v, a, j: where the axis goes next (a move from rest heads somewhere
-//!   from its first tick).
+//! * `at_rest` (registered) is v = a = j = 0 on the last clock; `heading_pos`/`heading_neg`
+//!   (registered) give the sign of the first non-zero of v, a, j: where the axis goes next (a
+//!   move from rest heads somewhere from its first tick).
 //! * Writes go to the standby bank.
 //! * `swap` arms a **program swap** for the tick T = `swap_last + 1` (low 32 bits of the time
 //!   base): the tick that brings `ticks` from `swap_last` to T is still the old program's (or
@@ -91,13 +93,16 @@ pub struct CoreModel {
     tick_count: u32,
     ticks: u64,
     chain: ChainState,
-    tick_div: u32,
+    /// The tick enable for the next edge (a register).
+    tick: bool,
     clocks: PhaseClocks,
     stop_phase: StopPhase,
     stop_limits: StopLimits,
     stop_law: Option<StopLaw>,
     stop_over: bool,
     heading: i8,
+    /// v = a = j = 0 before the last edge (a register).
+    at_rest: bool,
     swap_pending: bool,
     swap_last: u32,
 }
@@ -123,13 +128,14 @@ impl CoreModel {
             tick_count: 0,
             ticks: 0,
             chain: ChainState::default(),
-            tick_div: 0,
+            tick: false,
             clocks: phase_clocks(),
             stop_phase: StopPhase::Idle,
             stop_limits: StopLimits::default(),
             stop_law: None,
             stop_over: false,
             heading: 0,
+            at_rest: false,
             swap_pending: false,
             swap_last: 0,
         }
@@ -163,19 +169,12 @@ impl CoreModel {
         self.outputs()
     }
 
-    /// The tick enable before the next edge: the divider is due and no stop is computing.
-    #[inline]
-    fn tick_now(&self, tick_div: u32) -> bool {
-        let computing = matches!(self.stop_phase, StopPhase::Init(_) | StopPhase::Decide(_));
-        self.divider >= tick_div && !computing
-    }
-
     /// One rising clock edge with inputs `i` (read the outputs with [`CoreModel::outputs`]).
     #[inline]
     pub fn edge(&mut self, i: &CoreInputs) {
         let w = self.widths;
         // Combinational values before the edge.
-        let tick = self.tick_now(i.tick_div);
+        let tick = self.tick;
         // The armed swap is due on this tick: the state after it is the new program's start.
         let due = self.swap_pending
             && tick
@@ -293,8 +292,9 @@ impl CoreModel {
             self.ticks = self.ticks.wrapping_add(1);
         }
 
-        // The heading register: the sign of the first non-zero of v, a, j.
+        // The heading and at-rest registers: the sign of the first non-zero of v, a, j.
         let c = self.chain;
+        self.at_rest = c.v == 0 && c.a == 0 && c.j == 0;
         self.heading = if c.v != 0 {
             c.v.signum()
         } else if c.a != 0 {
@@ -395,16 +395,12 @@ impl CoreModel {
             self.mem_snap[b][a] = wrap(i.write_snap, w.d);
         }
 
-        self.tick_div = i.tick_div;
+        // The tick register: the divider is due and no stop computes after this edge.
+        let computing = matches!(self.stop_phase, StopPhase::Init(_) | StopPhase::Decide(_));
+        self.tick = self.divider >= i.tick_div && !computing;
     }
 
-    /// Changes the `tick_div` input between edges (the combinational `tick` output follows it
-    /// at once, as the hardware's does).
-    pub fn set_tick_div(&mut self, tick_div: u32) {
-        self.tick_div = tick_div;
-    }
-
-    /// The outputs as they stand (after the last edge, with the last `tick_div`).
+    /// The outputs as they stand (after the last edge).
     #[inline]
     pub fn outputs(&self) -> CoreOutputs {
         CoreOutputs {
@@ -421,8 +417,8 @@ impl CoreModel {
             stop_over: self.stop_over,
             tick_count: self.tick_count,
             ticks: self.ticks,
-            tick: self.tick_now(self.tick_div),
-            at_rest: self.chain.v == 0 && self.chain.a == 0 && self.chain.j == 0,
+            tick: self.tick,
+            at_rest: self.at_rest,
             heading_pos: self.heading > 0,
             heading_neg: self.heading < 0,
             active_bank: self.bank,

@@ -330,11 +330,6 @@ impl Device {
         self.frame_rx.clock(&frame_in);
         self.exec.clock(&exec_in);
         self.core.edge(&core_in);
-        // The core's tick is combinational on the executor's TICK_DIVIDER register: after this
-        // edge it compares with the register's new value, as the fabric's does (without this,
-        // the first tick after a CONFIGURE of the divider came a clock late).
-        self.core
-            .set_tick_div(self.exec.outputs().config.tick_divider);
         self.queue.clock(reset, exec_out.reply, tx_out.pop);
         self.reply_tx.clock(&tx_in, &live);
         self.tx_fifo

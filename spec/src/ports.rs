@@ -132,8 +132,8 @@ macro_rules! with_motion_core_ports {
                     ticks: bits[$crate::widths::TIME_BITS] u64, "Ticks since reset: the board's time base.";
                     heading_pos: bit[1] bool, "The axis heads forward (registered): on the last clock the first non-zero of v, a, j was positive.";
                     heading_neg: bit[1] bool, "The axis heads backward (registered).";
-                    at_rest: bit[1] bool, "The chain is at rest: v = a = j = 0.";
-                    tick: bit[1] bool, "The tick enable (one clock wide).";
+                    at_rest: bit[1] bool, "The chain was at rest on the last clock: v = a = j = 0 (registered: a 312-bit zero test does not feed the executor's decisions in the same clock).";
+                    tick: bit[1] bool, "The tick enable (one clock wide, a register).";
                     standby_count: bits[$crate::widths::INDEX_BITS] u8, "Segment count of the standby program (0: nothing to start).";
                     swap_pending: bit[1] bool, "A program swap is armed.";
                 }

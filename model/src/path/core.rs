@@ -142,8 +142,6 @@ impl PathCore {
 
     /// One clock edge with inputs `i`: every block and register from the values before it.
     pub fn clock(&mut self, i: &PathCoreInputs) {
-        // The core's tick is combinational in `tick_div`: its value before the edge.
-        self.core.set_tick_div(i.tick_div);
         let before = self.core.outputs();
         let si = Self::steppers_inputs(i, self.tick_q, before.x);
         self.tick_q = before.tick && !i.reset;
@@ -151,7 +149,7 @@ impl PathCore {
         self.steppers.clock(&si);
     }
 
-    /// The outputs as they stand (after the last edge, with the last `tick_div`).
+    /// The outputs as they stand (after the last edge).
     pub fn outputs(&self) -> PathCoreOutputs {
         Self::outputs_of(&self.core.outputs(), &self.steppers.outputs())
     }

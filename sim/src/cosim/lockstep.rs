@@ -50,9 +50,6 @@ impl ModelSide {
     pub fn clock(&mut self, i: &CoreInputs) -> (CoreOutputs, bool) {
         let ticked = self.ticking;
         self.model.edge(&self.pending);
-        // The registered tick_div already holds this clock's value, and the combinational
-        // `tick` output compares against it.
-        self.model.set_tick_div(i.tick_div);
         let m = self.model.outputs();
         self.ticking = m.tick && (m.busy || m.stopping);
         self.pending = *i;

@@ -229,6 +229,7 @@ impl Executor {
         // period and countdown before this clock (a CONFIGURE of the period, below, restarts
         // the countdown and takes effect from the next clock).
         let driven = i.core.busy || i.core.stopping;
+        let was_driven = self.was_driven;
         let period = cfg.telemetry_period;
         if period != 0 {
             if i.core.tick && driven {
@@ -281,7 +282,10 @@ impl Executor {
         // ended moving: a controlled stop into ErrorStop), then the errors (the emergency stop
         // last: it overrides everything).
         // (A swap armed while the axis rests is a start still to come.)
-        let settling = before.command.start || before.command.stop || before.command.swap;
+        // The core's `at_rest` is a register: a clock after the chain stopped being driven it
+        // tells where the last tick left the chain.
+        let settling =
+            before.command.start || before.command.stop || before.command.swap || was_driven;
         if matches!(
             o.state,
             AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::Stopping
