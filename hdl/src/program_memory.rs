@@ -3,6 +3,13 @@
 //! it to distributed LUT RAM on the 7 series — so the sequencer can fetch the next segment in
 //! the same clock and play one-tick segments back to back.
 //!
+//! Two read ports: any segment of a bank (the next one of the program playing), and segment 0
+//! of a bank (the first of the program a start or a swap takes), which is also kept in
+//! registers of its own (written with it) so that a synthesiser cannot merge the two reads
+//! into one behind an address multiplexer. Both addresses come from registers; the
+//! sequencer chooses between the two entries after the reads, so the swap's decision on a
+//! tick is not in front of the memory.
+//!
 //! rust-hdl has no asynchronous-read memory, so this block writes its Verilog by hand (as
 //! rust-hdl's own `RAM` does) and models the same behaviour for rust-hdl's simulator.
 
@@ -33,6 +40,12 @@ pub struct ProgramMemory {
     pub read_ticks: Signal<Out, Bits<TICK_BITS>>,
     /// Snap at `read_address`.
     pub read_snap: Signal<Out, Bits<D_BITS>>,
+    /// Bank whose segment 0 the second port reads.
+    pub first_bank: Signal<In, Bit>,
+    /// Tick count of segment 0 of `first_bank`.
+    pub first_ticks: Signal<Out, Bits<TICK_BITS>>,
+    /// Snap of segment 0 of `first_bank`.
+    pub first_snap: Signal<Out, Bits<D_BITS>>,
     _sim_ticks: Vec<Bits<TICK_BITS>>,
     _sim_snap: Vec<Bits<D_BITS>>,
 }
@@ -52,11 +65,16 @@ impl Logic for ProgramMemory {
         let r = self.read_address.val().index() + (usize::from(self.read_bank.val()) << ADDR_BITS);
         self.read_ticks.next = self._sim_ticks[r];
         self.read_snap.next = self._sim_snap[r];
+        let f = usize::from(self.first_bank.val()) << ADDR_BITS;
+        self.first_ticks.next = self._sim_ticks[f];
+        self.first_snap.next = self._sim_snap[f];
     }
 
     fn connect(&mut self) {
         self.read_ticks.connect();
         self.read_snap.connect();
+        self.first_ticks.connect();
+        self.first_snap.connect();
     }
 
     fn hdl(&self) -> Verilog {
@@ -72,15 +90,29 @@ initial begin
       snap_mem[i] = {d_bits}'d0;
    end
 end
+// Segment 0 of each bank, also in registers.
+reg [{tmsb}:0] first_ticks0 = {tick_bits}'d0, first_ticks1 = {tick_bits}'d0;
+reg [{dmsb}:0] first_snap0 = {d_bits}'d0, first_snap1 = {d_bits}'d0;
 always @(posedge clock) begin
    if (write_enable) begin
       ticks_mem[{{write_bank, write_address}}] <= write_ticks;
       snap_mem[{{write_bank, write_address}}] <= write_snap;
+      if (write_address == {addr_bits}'d0) begin
+         if (write_bank) begin
+            first_ticks1 <= write_ticks;
+            first_snap1 <= write_snap;
+         end else begin
+            first_ticks0 <= write_ticks;
+            first_snap0 <= write_snap;
+         end
+      end
    end
 end
 always @(*) begin
    read_ticks = ticks_mem[{{read_bank, read_address}}];
    read_snap = snap_mem[{{read_bank, read_address}}];
+   first_ticks = first_bank ? first_ticks1 : first_ticks0;
+   first_snap = first_bank ? first_snap1 : first_snap0;
 end
 ",
             depth = 1 << MEM_ADDR_BITS,
@@ -89,6 +121,7 @@ end
             dmsb = D_BITS - 1,
             tick_bits = TICK_BITS,
             d_bits = D_BITS,
+            addr_bits = ADDR_BITS,
         ))
     }
 }

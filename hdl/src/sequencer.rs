@@ -38,14 +38,20 @@ pub struct Sequencer {
     pub engage: Signal<In, Bit>,
     /// A controlled stop runs (its ticks are counted).
     pub stopping: Signal<In, Bit>,
-    /// Segments in the program (of the bank being read).
+    /// Segments in the program playing (the active bank's).
     pub count: Signal<In, Bits<INDEX_BITS>>,
-    /// Memory read data at `address`: tick count.
+    /// Memory read data at `address` (the program playing's next segment): tick count.
     pub entry_ticks: Signal<In, Bits<TICK_BITS>>,
     /// Memory read data at `address`: snap.
     pub entry_snap: Signal<In, Bits<D_BITS>>,
-    /// Memory read address within the bank: the next segment while busy, 0 while idle or
-    /// swapping.
+    /// Segments in the next program (the standby bank's), which a start or a swap takes.
+    pub first_count: Signal<In, Bits<INDEX_BITS>>,
+    /// The next program's segment 0: tick count (read on a port of its own).
+    pub first_ticks: Signal<In, Bits<TICK_BITS>>,
+    /// The next program's segment 0: snap.
+    pub first_snap: Signal<In, Bits<D_BITS>>,
+    /// Memory read address within the bank: the next segment (`index + 1`; the core reads
+    /// segment 0 of the next program on a port of its own).
     pub address: Signal<Out, Bits<ADDR_BITS>>,
     /// Snap for this tick (0 while idle).
     pub snap: Signal<Out, Bits<D_BITS>>,
@@ -62,14 +68,18 @@ pub struct Sequencer {
     busy_reg: DFF<Bit>,
     done_reg: DFF<Bit>,
     index_reg: DFF<Bits<INDEX_BITS>>,
+    /// `index + 1` (low bits), a register beside the index (meaningful while busy).
+    address_reg: DFF<Bits<ADDR_BITS>>,
     left: DFF<Bits<TICK_BITS>>,
     snap_reg: DFF<Bits<D_BITS>>,
     tick_count_reg: DFF<Bits<TICK_BITS>>,
     next_index: Signal<Local, Bits<INDEX_BITS>>,
+    /// The address after `address` (while busy `address` is `index + 1`).
+    address_after: Signal<Local, Bits<ADDR_BITS>>,
     // Sized constants (rust-hdl emits bare literals as 32-bit: WIDTH warnings).
     index_zero: Constant<Bits<INDEX_BITS>>,
     index_one: Constant<Bits<INDEX_BITS>>,
-    address_zero: Constant<Bits<ADDR_BITS>>,
+    address_one: Constant<Bits<ADDR_BITS>>,
     ticks_zero: Constant<Bits<TICK_BITS>>,
     ticks_one: Constant<Bits<TICK_BITS>>,
     snap_zero: Constant<Bits<D_BITS>>,
@@ -89,6 +99,9 @@ impl Default for Sequencer {
             count: Default::default(),
             entry_ticks: Default::default(),
             entry_snap: Default::default(),
+            first_count: Default::default(),
+            first_ticks: Default::default(),
+            first_snap: Default::default(),
             address: Default::default(),
             snap: Default::default(),
             busy: Default::default(),
@@ -99,13 +112,15 @@ impl Default for Sequencer {
             busy_reg: Default::default(),
             done_reg: Default::default(),
             index_reg: Default::default(),
+            address_reg: Default::default(),
             left: Default::default(),
             snap_reg: Default::default(),
             tick_count_reg: Default::default(),
             next_index: Default::default(),
+            address_after: Default::default(),
             index_zero: Constant::new(0.into()),
             index_one: Constant::new(1.into()),
-            address_zero: Constant::new(0.into()),
+            address_one: Constant::new(1.into()),
             ticks_zero: Constant::new(0.into()),
             ticks_one: Constant::new(1.into()),
             snap_zero: Constant::new(0.into()),
@@ -122,21 +137,20 @@ impl Logic for Sequencer {
             busy_reg,
             done_reg,
             index_reg,
+            address_reg,
             left,
             snap_reg,
             tick_count_reg
         );
         self.next_index.next = self.index_reg.q.val() + self.index_one.val();
-        if self.busy_reg.q.val() & !self.swap.val() {
-            self.address.next = self.next_index.val().get_bits::<ADDR_BITS>(0);
-        } else {
-            self.address.next = self.address_zero.val();
-        }
+        self.address_after.next = self.address_reg.q.val() + self.address_one.val();
+        self.address.next = self.address_reg.q.val();
         self.started.next = false;
         if self.reset.val() {
             self.busy_reg.d.next = false;
             self.done_reg.d.next = false;
             self.index_reg.d.next = self.index_zero.val();
+            self.address_reg.d.next = self.address_one.val();
             self.left.d.next = self.ticks_zero.val();
             self.snap_reg.d.next = self.snap_zero.val();
             self.tick_count_reg.d.next = self.ticks_zero.val();
@@ -146,15 +160,16 @@ impl Logic for Sequencer {
         } else if self.start.val() & !self.busy_reg.q.val() {
             self.started.next = true;
             self.index_reg.d.next = self.index_zero.val();
+            self.address_reg.d.next = self.address_one.val();
             self.tick_count_reg.d.next = self.ticks_zero.val();
-            if self.count.val() == self.index_zero.val() {
+            if self.first_count.val() == self.index_zero.val() {
                 self.done_reg.d.next = true;
                 self.snap_reg.d.next = self.snap_zero.val();
             } else {
                 self.busy_reg.d.next = true;
                 self.done_reg.d.next = false;
-                self.left.d.next = self.entry_ticks.val();
-                self.snap_reg.d.next = self.entry_snap.val();
+                self.left.d.next = self.first_ticks.val();
+                self.snap_reg.d.next = self.first_snap.val();
             }
         } else if self.tick.val() {
             if self.busy_reg.q.val() | self.stopping.val() {
@@ -162,16 +177,17 @@ impl Logic for Sequencer {
             }
             if self.swap.val() {
                 self.index_reg.d.next = self.index_zero.val();
+                self.address_reg.d.next = self.address_one.val();
                 self.tick_count_reg.d.next = self.ticks_zero.val();
-                if self.count.val() == self.index_zero.val() {
+                if self.first_count.val() == self.index_zero.val() {
                     self.busy_reg.d.next = false;
                     self.done_reg.d.next = true;
                     self.snap_reg.d.next = self.snap_zero.val();
                 } else {
                     self.busy_reg.d.next = true;
                     self.done_reg.d.next = false;
-                    self.left.d.next = self.entry_ticks.val();
-                    self.snap_reg.d.next = self.entry_snap.val();
+                    self.left.d.next = self.first_ticks.val();
+                    self.snap_reg.d.next = self.first_snap.val();
                 }
             } else if self.engage.val() {
                 // `done` is left: false while a program plays, and a program that ended before
@@ -181,6 +197,7 @@ impl Logic for Sequencer {
             } else if self.busy_reg.q.val() {
                 if self.left.q.val() == self.ticks_one.val() {
                     self.index_reg.d.next = self.next_index.val();
+                    self.address_reg.d.next = self.address_after.val();
                     if self.next_index.val() == self.count.val() {
                         self.busy_reg.d.next = false;
                         self.done_reg.d.next = true;

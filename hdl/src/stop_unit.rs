@@ -27,8 +27,8 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::stop::micro::{
-    Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED, FIELDS, FLAGS, KIND_HALT,
-    KIND_LOOP, KIND_OP, REGISTERS, ROM_BITS, TESTABLE_FLAGS, WORDS, WORD_BITS,
+    field, AMod, Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED, FIELDS,
+    FLAGS, KIND_HALT, KIND_LOOP, KIND_OP, REGISTERS, ROM_BITS, TESTABLE_FLAGS, WORDS, WORD_BITS,
 };
 use snapgen_model::stop::program::{microprogram, REG_NAMES};
 
@@ -212,7 +212,7 @@ impl Logic for StopUnit {
 /// The ROM: one `case` entry per instruction, each with its assembly as a comment.
 fn rom_case() -> String {
     let p = microprogram();
-    let digits = (ROM_BITS as usize).div_ceil(4);
+    let digits = (IR_BITS as usize).div_ceil(4);
     let mut s = String::new();
     for (pc, i) in p.code.iter().enumerate() {
         let label = if pc == p.prep {
@@ -226,16 +226,42 @@ fn rom_case() -> String {
         };
         s.push_str(label);
         s.push_str(&format!(
-            "   7'd{pc}: rom = {ROM_BITS}'h{:0digits$x}; // {}\n",
-            i.encode(),
+            "   7'd{pc}: rom = {IR_BITS}'h{:0digits$x}; // {}\n",
+            first_reads(i) << ROM_BITS | i.encode(),
             i.listing(&REG_NAMES)
         ));
     }
     s.push_str(&format!(
-        "   default: rom = {ROM_BITS}'h{:0digits$x}; // HALT\n",
-        Instr::Halt.encode()
+        "   default: rom = {IR_BITS}'h{:0digits$x}; // HALT\n",
+        first_reads(&Instr::Halt) << ROM_BITS | Instr::Halt.encode()
     ));
     s
+}
+
+/// Bits of an instruction word in the fabric: the ROM word and [`first_reads`] above it.
+const IR_BITS: u32 = ROM_BITS + 12;
+
+/// The register file's read addresses on an instruction's first clock (step 0), kept in the
+/// ROM above its word so that no decoding lies between the next instruction and the register
+/// file: `{A_SRC[3:0], ak}` in bits 11..6 and `{B_REG, kr}` in bits 5..0, with the words read
+/// at step 0 by the template's `read_word` and `a_word` (kr = 2 for a right shift, else 0;
+/// ak = kr + 1 one word right, kr − 2 two words left, else kr). 0 for LOOP and HALT.
+fn first_reads(i: &Instr) -> u128 {
+    let Instr::Op(op) = i else {
+        return 0;
+    };
+    let w = i.encode();
+    let bits = |name: &str| {
+        let f = field(name);
+        (w >> f.lsb) & ((1 << f.bits) - 1)
+    };
+    let kr: u128 = if op.a_mod == AMod::Shr { 2 } else { 0 };
+    let ak = match op.a_mod {
+        AMod::WordRight => kr + 1,
+        AMod::WordLeft2 => (kr + 2) & 3,
+        _ => kr,
+    };
+    ((bits("A_SRC") & 0xf) << 2 | ak) << 6 | bits("B_REG") << 2 | kr
 }
 
 /// The law's case analysis on the flags (the second implementation of `micro::Derived`): each
@@ -352,8 +378,17 @@ fn stop_unit_verilog() -> String {
         .value("K_LOOP", KIND_LOOP)
         .value("K_HALT", KIND_HALT)
         .value("FLAGS", FLAGS)
-        .value("ROM_TOP", ROM_BITS - 1)
-        .value("IR_HALT", format!("{ROM_BITS}'h{:x}", Instr::Halt.encode()))
+        .value(
+            "IR_HALT",
+            format!(
+                "{IR_BITS}'h{:x}",
+                first_reads(&Instr::Halt) << ROM_BITS | Instr::Halt.encode()
+            ),
+        )
+        .value("IR_TOP", IR_BITS - 1)
+        .value("RA0_LO", ROM_BITS + 6)
+        .value("RB0_HI", ROM_BITS + 5)
+        .value("RB0_LO", ROM_BITS)
         .value("LOCALS_A", 1 + 2 + 2 + 2 + 3 + 1 + 1 + 48 + 48)
         .value("LOCALS_B", 7 + 48 * 3 + 49)
         .block("flag_names", flags)

@@ -25,15 +25,26 @@ localparam [2:0] S_SIGN = 3'd0, S_NSIGN = 3'd1, S_ZERO_A = 3'd2, S_SHIFT = 3'd3,
 localparam [1:0] C_AND = 2'd2, C_OR = 2'd3;
 //@ flag_names
 reg [2:0] phase = PH_IDLE;
+reg ready_q = 1'b0;                      // phase == PH_READY, registered with it
 reg [6:0] pc = 7'd0;
-reg [{{ROM_TOP}}:0] ir = {{IR_HALT}};             // the instruction at pc
+reg [{{IR_TOP}}:0] ir = {{IR_HALT}};              // the instruction at pc (and its first_reads)
 reg [1:0] step = 2'd0;
+reg step_first = 1'b0, step_last = 1'b0;  // step is 1, 3 (registered with it)
+// The register file's read addresses on this clock ({A_SRC[3:0], ak}, {B_REG, kr} of ir and
+// step), computed on the clock before from the instruction and step it leaves: no decoding
+// between ir and the register file's read.
+reg [5:0] ra_q = 6'd0;
+reg [5:0] rb_q = 6'd0;
 reg [5:0] loop_count = 6'd0;
 reg [6:0] loop_pc = 7'd0;
+reg [{{IR_TOP}}:0] ir_inc = {{IR_HALT}};          // the instruction at pc + 1
+reg [{{IR_TOP}}:0] ir_loop = {{IR_HALT}};         // the instruction at loop_pc
+reg [{{IR_TOP}}:0] ir_loop_inc = {{IR_HALT}};     // the instruction at loop_pc + 1
 reg [47:0] a_q = 48'd0;                  // operand words read on the previous clock
 reg [47:0] b_q = 48'd0;
 // The instruction decoded on step 0 (its conditions evaluated), for the adding steps.
-reg c_shift_in = 1'b0;                   // the bit shifted into a left shift
+reg shl_in = 1'b0;                       // the bit a left shift takes into this word: the
+                                         // condition on word 0, then the last word's top bit
 reg c_pred = 1'b0;                       // write the result and the flag
 reg c_flag = 1'b0;                       // a flag set from a condition
 reg do_shl = 1'b0, do_shr = 1'b0;        // A shifted one bit left, right
@@ -47,18 +58,25 @@ reg shift_bit = 1'b0;                    // the bit a shift moves across,
 reg zero_acc = 1'b0;                     // the result is zero so far,
 reg fill = 1'b0;                         // the sign of a one-word right shift's source
 // The flags. An instruction's flag write is applied a clock after its last step (`flag_pend`:
-// the adder's result and the flag's combination are not in one clock's path); `flags`, what
-// every reader sees, is the register with the pending write applied: the same value on every
-// clock as if it had been written at once.
+// the adder's result and the flag's combination are not in one clock's path): on that step
+// the flags are computed both ways, for a result's sign of 0 and of 1 (`flags_if0`,
+// `flags_if1`), and the sign is kept (`flag_sign_q`, the adder's last bit). `flags`, what every
+// reader sees, is the register with the pending write applied: the same value on every clock
+// as if it had been written at once.
 reg [FLAG_COUNT-1:0] flags_q = {FLAG_COUNT{1'b0}};
-reg flag_pend = 1'b0;                    // a flag write is pending: flag_src_q into flag_we_q
-reg flag_src_q = 1'b0;
-reg [FLAG_COUNT-1:0] flag_we_q = {FLAG_COUNT{1'b0}};
-reg flag_and_q = 1'b0, flag_or_q = 1'b0;
-wire [FLAG_COUNT-1:0] flag_new = flag_and_q ? (flags_q & {FLAG_COUNT{flag_src_q}})
-   : flag_or_q ? (flags_q | {FLAG_COUNT{flag_src_q}}) : {FLAG_COUNT{flag_src_q}};
-wire [FLAG_COUNT-1:0] flags = flag_pend ? ((flags_q & ~flag_we_q) | (flag_we_q & flag_new))
-   : flags_q;
+reg flag_pend = 1'b0;
+reg flag_sign_q = 1'b0;
+reg [FLAG_COUNT-1:0] flags_if0 = {FLAG_COUNT{1'b0}};
+reg [FLAG_COUNT-1:0] flags_if1 = {FLAG_COUNT{1'b0}};
+wire [FLAG_COUNT-1:0] flags = flag_pend ? (flag_sign_q ? flags_if1 : flags_if0) : flags_q;
+
+// The flags after writing flag source `f` into the flag(s) `we`, combined with the old by
+// AND, OR or not at all.
+function automatic [FLAG_COUNT-1:0] flag_write(input [FLAG_COUNT-1:0] old,
+      input [FLAG_COUNT-1:0] we, input and_, input or_, input f);
+   flag_write = (old & ~we) | (we & (and_ ? (old & {FLAG_COUNT{f}})
+      : or_ ? (old | {FLAG_COUNT{f}}) : {FLAG_COUNT{f}}));
+endfunction
 reg [D_BITS-1:0] jlim = {D_BITS{1'b0}};     // the limits, latched on the request
 reg [D_BITS-1:0] alim = {D_BITS{1'b0}};
 reg [D_BITS-1:0] snap_reg = {D_BITS{1'b0}};
@@ -70,12 +88,32 @@ initial for (rf_i = 0; rf_i < 64; rf_i = rf_i + 1) rf[rf_i] = 48'd0;
 // ---- The microprogram (snapgen_model::stop::program) -----------------------------------------
 // In logic, not block RAM: a block RAM's clock-to-out (5.6 ns on an ECP5) would start the
 // engine's operand read.
-function automatic [{{ROM_TOP}}:0] rom(input [6:0] addr);
+function automatic [{{IR_TOP}}:0] rom(input [6:0] addr);
    (* rom_style = "logic" *) case (addr)
 //@ rom_cases
    endcase
 endfunction
 //@ instruction_fields
+// The next instruction is ROM[pc + 1] (`ir_inc`), ROM[loop_pc] (`ir_loop`), ir itself or an
+// entry point's word: each a register or a constant, chosen by the next-pc decision. The one
+// ROM lookup, ROM[pc + 2] from pc, becomes `ir_inc` when pc moves on (and `ir_loop_inc`, with
+// the loop's start): the ROM is behind no decision and before no other logic.
+wire [6:0] pc_inc = pc + 7'd1;
+wire [6:0] pc_inc2 = pc + 7'd2;
+
+// The word of a 3-word value an instruction's step reads: kr for B (high word first for a right
+// shift of A) and ak for A (kr, kr + 1 one word right, kr - 2 two words left).
+function automatic [1:0] read_word(input [2:0] a_mod, input [1:0] s);
+   read_word = (a_mod == M_SHR) ? 2'd2 - s : s;
+endfunction
+function automatic [1:0] a_word(input [2:0] a_mod, input [1:0] s);
+   reg [1:0] k;
+   begin
+      k = read_word(a_mod, s);
+      a_word = (a_mod == M_WLEFT2) ? k - 2'd2 : (a_mod == M_WRIGHT) ? k + 2'd1 : k;
+   end
+endfunction
+wire [{{IR_TOP}}:0] ir_inc2 = rom(pc_inc2);
 // ---- Conditions: flags, the law's case analysis on them (micro::Derived), true -------------
 // (The engine's process writes every selection out: a function's arguments and locals cost a
 // simulator stores on every clock, executed or not.)
@@ -91,12 +129,16 @@ always @(posedge clock) begin : engine
    reg a_below, a_above;
    reg [47:0] a_ext, a_raw;
    // Add: word step - 1, from the words read.
-   reg first, last, shift_out, a_zero, a_wide, f_src, write;
+   reg first, last, shift_out, a_zero, a_wide, f_rest, write;
    reg [47:0] a_op, b_op, result;
    reg [48:0] sum;
    reg [31:0] conds;
    reg [6:0] pc_next;
-   reg fetch;                            // load pc and ir (with ROM[pc_next])
+   reg [{{IR_TOP}}:0] ir_next;              // ROM[pc_next]
+   reg [{{IR_TOP}}:0] ir_inc_next;          // ROM[pc_next + 1]
+   reg next_new;                         // ir_next is an instruction's first clock
+   reg fetch;                            // load pc and ir
+   reg [1:0] step_next;
    // The law's case analysis on the flags (micro::Derived), for the step-0 conditions.
 //@ derived_declarations
    // The step-0 conditions: b's, and the shift-in, predicate and flag conditions.
@@ -104,20 +146,25 @@ always @(posedge clock) begin : engine
    // Every local has a value on every clock (none is a register); the datapath's are computed
    // only while the engine runs.
    {shr, kr, ak, ke, ak_wide, a_below, a_above, a_ext, a_raw} = {{LOCALS_A}}'d0;
-   {first, last, shift_out, a_zero, a_wide, f_src, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
+   {first, last, shift_out, a_zero, a_wide, f_rest, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
    conds = 32'd0;
    pc_next = pc;
+   ir_next = ir;
+   ir_inc_next = ir_inc;
+   next_new = 1'b0;
    fetch = 1'b0;
+   step_next = step;
 //@ derived_zeros
    {c_b, c_shift, c_p, c_f} = 4'd0;
    if (running) begin
       shr = i_a_mod == M_SHR;
-      kr = shr ? 2'd2 - step : step;
-      // The word of A read: kr, kr + 1 (one word right) or kr - 2 (two words left).
+      kr = read_word(i_a_mod, step);
+      // The word of A read: kr, kr + 1 (one word right) or kr - 2 (two words left); below
+      // word 0 (zero) or above word 2 (the sign fill).
       ak_wide = (i_a_mod == M_WRIGHT) ? {1'b0, kr} + 3'd1 : {1'b0, kr};
       a_below = (i_a_mod == M_WLEFT2) && (kr < 2'd2);
       a_above = ak_wide == 3'd3;
-      ak = (i_a_mod == M_WLEFT2) ? kr - 2'd2 : ak_wide[1:0];
+      ak = a_word(i_a_mod, step);
       // External values, word ak of their 144-bit extension: the chain's registers
       // sign-extended, the limits zero-extended.
       case (i_a_src)
@@ -126,11 +173,11 @@ always @(posedge clock) begin : engine
       default: a_ext = 48'd0;                                    // 16: zero
       endcase
       a_raw = a_below ? 48'd0 : a_above ? {48{fill}}
-         : (i_a_src[4] ? a_ext : rf[{i_a_src[3:0], ak}]);
-      first = step == 2'd1;
-      last = step == 2'd3;
+         : (i_a_src[4] ? a_ext : rf[ra_q]);
+      first = step_first;
+      last = step_last;
       ke = shr ? 2'd3 - step : step - 2'd1;
-      a_op = do_shl ? {a_q[46:0], first ? c_shift_in : shift_bit}
+      a_op = do_shl ? {a_q[46:0], shl_in}
          : do_shr ? {first ? a_q[47] : shift_bit, a_q[47:1]} : a_q;
       shift_out = do_shl ? a_q[47] : (do_shr & a_q[0]);
       b_op = b_en ? (b_q ^ {48{b_inv}}) : 48'd0;
@@ -140,13 +187,27 @@ always @(posedge clock) begin : engine
       // of word 2, not all equal). Both off the adder's path.
       a_zero = (first | zero_acc) & (a_q == 48'd0);
       a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
-      f_src = (src[0] & result[47]) | (src[1] & ~result[47]) | (src[2] & a_zero)
-         | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
+      f_rest = (src[2] & a_zero) | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
       write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
       // The next instruction.
-      if (i_kind == K_LOOP) pc_next = pc + 7'd1;
-      else if ((i_kind == K_OP) && last)
-         pc_next = (i_end_loop && (loop_count != 6'd1)) ? loop_pc : pc + 7'd1;
+      if (i_kind == K_LOOP) begin
+         pc_next = pc_inc;
+         ir_next = ir_inc;
+         ir_inc_next = ir_inc2;
+         next_new = 1'b1;
+      end else if ((i_kind == K_OP) && last) begin
+         if (i_end_loop && (loop_count != 6'd1)) begin
+            pc_next = loop_pc;
+            ir_next = ir_loop;
+            ir_inc_next = ir_loop_inc;
+            next_new = 1'b1;
+         end else begin
+            pc_next = pc_inc;
+            ir_next = ir_inc;
+            ir_inc_next = ir_inc2;
+            next_new = 1'b1;
+         end
+      end
       fetch = 1'b1;
       if (write && i_write) rf[{i_dst, ke}] <= result;
    end
@@ -161,33 +222,44 @@ always @(posedge clock) begin : engine
       case (phase)
       PH_IDLE: if (request) begin
          phase <= PH_PREP;
-         step <= 2'd0;
+         step_next = 2'd0;
          jlim <= jerk_limit;
          alim <= accel_limit;
          pc_next = PC_PREP;
+         ir_next = rom(PC_PREP);
+         ir_inc_next = rom(PC_PREP + 7'd1);
+         next_new = 1'b1;
          fetch = 1'b1;
       end
       PH_ARMED: if (engage) begin
          phase <= PH_RUN;
-         step <= 2'd0;
+         step_next = 2'd0;
          pc_next = PC_INIT;
+         ir_next = rom(PC_INIT);
+         ir_inc_next = rom(PC_INIT + 7'd1);
+         next_new = 1'b1;
          fetch = 1'b1;
       end
       PH_READY: if (tick) begin
          phase <= PH_RUN;
-         step <= 2'd0;
+         step_next = 2'd0;
          pc_next = PC_DECIDE;
+         ir_next = rom(PC_DECIDE);
+         ir_inc_next = rom(PC_DECIDE + 7'd1);
+         next_new = 1'b1;
          fetch = 1'b1;
       end
       default: if (running) begin
          case (i_kind)
          K_LOOP: begin
             loop_count <= i_count;
-            loop_pc <= pc + 7'd1;
+            loop_pc <= pc_inc;
+            ir_loop <= ir_inc;
+            ir_loop_inc <= ir_inc2;
          end
          K_OP: begin
             a_q <= a_raw;
-            b_q <= rf[{i_b_reg, kr}];
+            b_q <= rf[rb_q];
             if ((i_a_mod == M_WRIGHT) && !last) fill <= a_raw[47];
             if (step == 2'd0) begin
 //@ derived_conditions
@@ -195,7 +267,7 @@ always @(posedge clock) begin : engine
                c_shift = conds[i_shift_in[4:0]] ^ i_shift_in[5];
                c_p = conds[i_pred[4:0]] ^ i_pred[5];
                c_f = conds[i_flag_cond[4:0]] ^ i_flag_cond[5];
-               c_shift_in <= c_shift;
+               shl_in <= c_shift;
                c_pred <= c_p;
                c_flag <= c_f;
                do_shl <= i_a_mod == M_SHL;
@@ -214,6 +286,7 @@ always @(posedge clock) begin : engine
                carry <= sum[48];
                zero_acc <= a_zero;
                shift_bit <= shift_out;
+               shl_in <= shift_out;
             end
             if (write && i_to_snap) begin
                case (ke)
@@ -224,13 +297,13 @@ always @(posedge clock) begin : engine
             end
             if (write && last) begin
                flag_pend <= 1'b1;
-               flag_src_q <= f_src;
-               flag_we_q <= flag_we;
-               flag_and_q <= flag_and;
-               flag_or_q <= flag_or;
+               // The source: the result's sign (src[0]), its inverse (src[1]) or the rest.
+               flag_sign_q <= result[47];
+               flags_if0 <= flag_write(flags, flag_we, flag_and, flag_or, src[1] | f_rest);
+               flags_if1 <= flag_write(flags, flag_we, flag_and, flag_or, src[0] | f_rest);
             end
             if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
-            step <= last ? 2'd0 : step + 2'd1;
+            step_next = last ? 2'd0 : step + 2'd1;
          end
          K_HALT: begin
             // Prep done, or a decision made (or the chain found at rest).
@@ -243,11 +316,22 @@ always @(posedge clock) begin : engine
       end
       endcase
    end
-   // One ROM read, for whichever instruction comes next.
+   // The phase after this edge is READY (the chain's snap multiplexer reads it from a register).
+   ready_q <= !reset && !cancel && (((phase == PH_READY) && !tick)
+      || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags[F_REST]));
+   // The instruction that comes next, and its address.
    if (fetch) begin
       pc <= pc_next;
-      ir <= rom(pc_next);
+      ir <= ir_next;
+      ir_inc <= ir_inc_next;
    end
+   step <= step_next;
+   step_first <= step_next == 2'd1;
+   step_last <= step_next == 2'd3;
+   // The read addresses of the next clock: a new instruction's first (step 0) from its ROM
+   // word, else this instruction's at the step after this edge.
+   ra_q <= next_new ? ir_next[{{IR_TOP}}:{{RA0_LO}}] : {i_a_src[3:0], a_word(i_a_mod, step_next)};
+   rb_q <= next_new ? ir_next[{{RB0_HI}}:{{RB0_LO}}] : {i_b_reg, read_word(i_a_mod, step_next)};
 end
 
 // ---- Heading (for the limit switches) and at rest, registered: the sign of v, else a, else j --
@@ -272,7 +356,7 @@ always @(*) begin
    // The phase after this edge is RUN (the tick divider's register is told it).
    computing_next = !reset && !cancel && (((phase == PH_ARMED) && engage)
       || ((phase == PH_READY) && tick) || ((phase == PH_RUN) && (i_kind != K_HALT)));
-   ready = phase == PH_READY;
+   ready = ready_q;
    snap = snap_reg;
    over = flags[F_EXCEEDS];
    heading_pos = heading_pos_q;
