@@ -3,12 +3,12 @@
 //! it to distributed LUT RAM on the 7 series — so the sequencer can fetch the next segment in
 //! the same clock and play one-tick segments back to back.
 //!
-//! Two read ports: any segment of a bank (the next one of the program playing), and segment 0
-//! of a bank (the first of the program a start or a swap takes), which is also kept in
-//! registers of its own (written with it) so that a synthesiser cannot merge the two reads
-//! into one behind an address multiplexer. Both addresses come from registers; the
-//! sequencer chooses between the two entries after the reads, so the swap's decision on a
-//! tick is not in front of the memory.
+//! Two reads: any segment of a bank (the next one of the program playing), from the memory, and
+//! segment 0 of a bank (the first of the program a start or a swap takes), from registers that
+//! keep a copy of each bank's segment 0 (written with it; as a second port of the same memory
+//! a synthesiser merged the two reads into one behind an address multiplexer). Both come from
+//! registers' addresses; the sequencer chooses between the two entries after the reads, so
+//! the swap's decision on a tick is not in front of the memory.
 //!
 //! rust-hdl has no asynchronous-read memory, so this block writes its Verilog by hand (as
 //! rust-hdl's own `RAM` does) and models the same behaviour for rust-hdl's simulator.

@@ -7,7 +7,7 @@
 //! program tick is the first tick strictly after the clock that accepted the start.
 //!
 //! A program swap (`swap`, on a tick, from [`crate::swap_timer`]) loads segment 0 of the
-//! program being read (the standby bank's, at address 0) in place of the tick's usual step,
+//! next program (the standby bank's, `first_*`) in place of the tick's usual step,
 //! busy or not, so the next tick is the new program's first.
 //!
 //! When a controlled stop is taken (`engage`, on a tick) a program playing is cut there: busy
@@ -32,7 +32,8 @@ pub struct Sequencer {
     pub start: Signal<In, Bit>,
     /// Stop now.
     pub abort_move: Signal<In, Bit>,
-    /// A program swap is due on this clock's tick: load segment 0 (read at address 0).
+    /// A program swap is due on this clock's tick: load the next program's segment 0
+    /// (`first_*`).
     pub swap: Signal<In, Bit>,
     /// A controlled stop is taken on this clock's tick: cut the program.
     pub engage: Signal<In, Bit>,

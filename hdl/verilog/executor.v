@@ -83,8 +83,11 @@ reg [TELEMETRY_PERIOD_BITS-1:0] telemetry_left_q = {TELEMETRY_PERIOD_BITS{1'b0}}
 reg was_driven_q = 1'b0, n_was_driven;
 
 // ---- Arguments and axis state: why the command is refused (0: accepted) ----------------------
+// The chain is at rest: the core's at_rest is a register, one clock old, so on the clock after
+// the chain was driven (its last tick may have moved it) it does not count.
+wire rested = at_rest && !was_driven_q;
 // The axis moves: a program plays, a stop runs, or v, a or j is not 0.
-wire moving = busy || stopping || !at_rest;
+wire moving = busy || stopping || !rested;
 wire stop_limits_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= stop_accel_q);
 // With the controller on, POWER 1 wants a following-error limit.
 wire servo_ready = (servo_period_q == {SERVO_PERIOD_BITS{1'b0}})
@@ -129,7 +132,7 @@ always @(*) begin
       else if (stopping) reason = R_STOPPING;
       else if (swap_pending) reason = R_SWAP_PENDING;
       else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
-      else if (!at_rest) reason = R_BUSY;
+      else if (!rested) reason = R_BUSY;
       else if (toward_limit) reason = R_LIMIT;
    CMD_SWAP_AT:
       if (swap_far) reason = R_BAD_ARGUMENT;
@@ -140,7 +143,7 @@ always @(*) begin
       else if (swap_pending) reason = R_SWAP_PENDING;
       else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
       else if (swap_late) reason = R_LATE;
-      else if (at_rest && !busy && toward_limit) reason = R_LIMIT;
+      else if (rested && !busy && toward_limit) reason = R_LIMIT;
    CMD_STOP:
       if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
    CMD_HALT:

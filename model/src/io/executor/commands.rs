@@ -79,7 +79,10 @@ impl Executor {
     /// Arguments and axis state: why the command is refused, if it is.
     fn check(&self, i: &ExecutorInputs, s: AxisState, cfg: Config) -> Result<(), Reason> {
         let rx = &i.rx;
-        let moving = i.core.busy || i.core.stopping || !i.core.at_rest;
+        // The core's `at_rest` is a register, one clock old: on the clock after the chain was
+        // driven (its last tick may have moved it) it does not count.
+        let rested = i.core.at_rest && !self.was_driven;
+        let moving = i.core.busy || i.core.stopping || !rested;
         // In ErrorStop with the amplifier off and the axis at rest nothing can move, as while
         // Disabled: the parameters settable only while Disabled may be set (INPUT_POLARITY
         // made the emergency stop read active: it can be set back, then RESET).
@@ -105,7 +108,7 @@ impl Executor {
                 _ if i.core.stopping => Some(Reason::Stopping),
                 _ if i.core.swap_pending => Some(Reason::SwapPending),
                 _ if i.core.standby_count == 0 => Some(Reason::NoProgram),
-                _ if !i.core.at_rest => Some(Reason::Busy),
+                _ if !rested => Some(Reason::Busy),
                 _ if toward_limit => Some(Reason::Limit),
                 _ => None,
             },
@@ -119,7 +122,7 @@ impl Executor {
                 // The lead is one clock old and the core arms one clock later: the time base
                 // may have ticked twice by then, and the core wants three ticks of lead.
                 _ if (self.swap_lead as i64) < SWAP_MIN_LEAD => Some(Reason::Late),
-                _ if i.core.at_rest && !i.core.busy && toward_limit => Some(Reason::Limit),
+                _ if rested && !i.core.busy && toward_limit => Some(Reason::Limit),
                 _ => None,
             },
             code::STOP if s == AxisState::Disabled => Some(Reason::NotEnabled),
@@ -248,5 +251,49 @@ impl Executor {
             }
             _ => {}
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::frame_rx::FrameRxOutputs;
+
+    /// The reply to POWER 0 on a clock with the chain at rest by the core's (registered)
+    /// `at_rest`, busy and stopping low, after a clock with the chain driven or not.
+    fn power_off_reply(driven_before: bool) -> Option<ReplyDesc> {
+        let mut e = Executor::new(0, 1000, 0);
+        e.clock(&ExecutorInputs {
+            reset: true,
+            ..Default::default()
+        });
+        let mut i = ExecutorInputs::default();
+        i.core.at_rest = true;
+        i.core.busy = driven_before;
+        e.clock(&i);
+        i.core.busy = false;
+        i.rx = FrameRxOutputs {
+            frame: true,
+            cmd: code::POWER,
+            seq: 1,
+            len: 1,
+            ..Default::default()
+        };
+        e.clock(&i).reply
+    }
+
+    #[test]
+    fn a_chain_driven_on_the_last_clock_is_not_taken_for_at_rest() {
+        // A program's last tick may move the chain (a one-tick program from rest): on the
+        // next clock busy is low and the core's at_rest, a clock old, still says at rest. The
+        // axis moves: POWER 0 is refused.
+        let reply = power_off_reply(true).expect("a reply");
+        assert_eq!(
+            (reply.kind, reply.aux),
+            (ReplyKind::Nak, Reason::Busy as u8)
+        );
+        // A clock later, or with the chain not driven before, it is taken.
+        let reply = power_off_reply(false).expect("a reply");
+        assert_eq!(reply.kind, ReplyKind::Ack);
     }
 }

@@ -240,12 +240,11 @@ impl Executor {
                     self.telemetry_left -= 1;
                 }
             }
-            if self.was_driven && !driven {
+            if was_driven && !driven {
                 self.out.telemetry = true;
                 self.telemetry_left = period;
             }
         }
-        self.was_driven = driven;
 
         // The watchdog: milliseconds since the last good frame.
         let expired = cfg.watchdog_ms != 0 && self.watchdog_count >= cfg.watchdog_ms;
@@ -336,6 +335,8 @@ impl Executor {
         }
 
         self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.core.ticks);
+        // (Registered last: the commands above read the value before this clock.)
+        self.was_driven = driven;
         self.out
     }
 }
