@@ -43,7 +43,9 @@ route() {
   local module="$1" label="$2" dir="$work/$1"
   mkdir -p "$dir"
   python3 scripts/timing_wrap.py "$work/$module.v" "$module" >"$dir/timing_top.v"
-  yosys -q -p "read_verilog $dir/timing_top.v; synth_ecp5 -top timing_top -json $dir/timing_top.json" \
+  # Relative paths: the netlist's source attributes, which nextpnr's placement depends on,
+  # then do not depend on the temporary directory's name (the result repeats anywhere).
+  (cd "$dir" && yosys -q -p "read_verilog timing_top.v; synth_ecp5 -top timing_top -json timing_top.json") \
     >"$dir/yosys.log" 2>&1 || { tail -5 "$dir/yosys.log" >&2; exit 1; }
   # (The WebAssembly build sees only its working directory: relative paths.)
   local status=0
