@@ -6,17 +6,24 @@
 //! # Datapath (one sample)
 //!
 //! ```text
-//! sample clock  e48 = x[111:64] − {count, 16'h8000}; vs = v[103:48]; as = a[103:40] (the I/O top
-//!               brings in these slices)
-//! step 0        fault, peak, e = sat32(e48), F += Δ − (F >>> k) with Δ = e − e_prev,
-//!               I = clamp(I + e) unless held (the derivative operand is F >>> k);
-//!               the first term's operand magnitude |e| and gain KP
+//! sample clock  e48 = x[111:64] − {count, 16'h8000}, e = sat32(e48); vs = v[103:48];
+//!               as = a[103:40] (the I/O top brings in these slices)
+//! step 0        fault, peak; the first term's operand magnitude |e| and gain KP;
+//!               sum = 2^47 (the rounding's half)
 //! 5 terms × 5   the products of a gain digit (most significant first) and the operand's
 //!               magnitude (four 16 × 16, registered: the DSP blocks' own register) on 3
-//!               clocks, each added one clock later, acc = (acc << 16) + partial; then
-//!               sum ±= acc, the next operand and gain
-//! finish        u = (sum + 2^47) >>> 48; duty = clamp(u, ±OUTPUT_LIMIT); saturation flags
+//!               clocks, each added one clock later, acc = (acc << 16) + partial (carry-save:
+//!               one carry chain); the next term's operand registered on the last of these;
+//!               then sum ±= acc, the next operand's magnitude and gain. Term 0's first
+//!               three clocks also update D and the integrator, read from term 1's operand
+//!               on: Δ = e − e_prev, I + e, F >>> k; then I = clamp(I + e) unless held,
+//!               F −= F >>> k; then F += Δ
+//! finish        u = sum >>> 48; duty = clamp(u, ±OUTPUT_LIMIT); saturation flags
 //! ```
+//!
+//! Every clock has at most one carry chain (an addition or a compare) after its registers —
+//! the limits' negations are latched with the sample, |x| > L is tested as x > L or x < −L —
+//! so that the I/O top closes routed timing (docs/HDL.md).
 //!
 //! Gains are not negative, so a term's sign is its operand's; products are of magnitudes and
 //! exact (112 bits), the sum is exact (116 bits): the result is the model's integer law, to the
@@ -159,8 +166,20 @@ struct Rtl {
     integral: u64,
     e_prev: u32,
     primed: bool,
+    /// The sample's `e = sat32(e48)`, taken with it.
+    e: u32,
+    /// `Δ = e − e_prev` (33-bit).
+    delta: u64,
+    /// `F >> k`, the filter's leak.
+    d_filt: u64,
+    /// `I + e` (49-bit).
+    i_sum: u64,
+    /// The integrator holds.
+    hold: bool,
     sat_hi: bool,
     sat_lo: bool,
+    /// The next term's operand (64-bit two's complement), registered the clock before it starts.
+    op: u64,
     mag: u64,
     neg: bool,
     gain: u64,
@@ -202,16 +221,15 @@ struct Ports {
 }
 
 impl Rtl {
-    /// Operand `t` (e, I, D, vs, as) as its 64-bit magnitude and sign.
-    fn operand(&self, t: u32, e: i128, integral: u64, d: u64) -> (u64, bool) {
-        let value: i128 = match t {
-            0 => e,
-            1 => sext(u128::from(integral), 48),
-            2 => sext(u128::from(d), 48) >> self.d_filter,
+    /// Operand `t` (I, D, vs, as, and as again after the last term, as the Verilog's
+    /// multiplexer; e is term 0's, taken on step 0).
+    fn operand(&self, t: u32) -> i128 {
+        match t {
+            1 => sext(u128::from(self.integral), 48),
+            2 => sext(u128::from(self.f), 48) >> self.d_filter,
             3 => sext(u128::from(self.vs), 56),
             _ => sext(u128::from(self.as_), 64),
-        };
-        (value.unsigned_abs() as u64, value < 0)
+        }
     }
 
     fn clock(&mut self, p: &Ports) {
@@ -244,6 +262,10 @@ impl Rtl {
             // The sample: the error and the feed-forward operands.
             let centre = (u64::from(p.count) << E_FRAC) | (1 << (E_FRAC - 1));
             n.e48 = p.ref_position.wrapping_sub(centre) & ((1 << 48) - 1);
+            n.e = low(
+                sext(u128::from(n.e48), 48).clamp(-(1 << 31), (1 << 31) - 1),
+                32,
+            ) as u32;
             n.vs = p.velocity;
             n.as_ = p.accel;
             n.gains = [c.kp, c.ki, c.kd, c.kv, c.ka].map(|g| g as u64);
@@ -256,36 +278,51 @@ impl Rtl {
         }
         if self.busy {
             if self.step0 {
+                // The following check, the peak, e and term 0's operand; D and the
+                // integrator on term 0's first clocks, below.
                 let e48 = sext(u128::from(self.e48), 48);
                 n.fault = e48.unsigned_abs() > u128::from(self.following_limit) << E_FRAC;
-                let e = e48.clamp(-(1 << 31), (1 << 31) - 1);
+                let e = sext(u128::from(self.e), 32);
                 if !p.start {
                     n.peak = self.peak.max(e.unsigned_abs() as u32);
                 }
-                let e_prev = sext(u128::from(self.e_prev), 32);
-                let delta = if self.primed { e - e_prev } else { 0 };
-                let f = sext(u128::from(self.f), 48);
-                n.f = low(f + delta - (f >> self.d_filter), 48) as u64;
-                let hold = (self.sat_hi && e > 0) || (self.sat_lo && e < 0);
-                let mut integral = sext(u128::from(self.integral), 48);
-                if !hold {
-                    let lim = i128::from(self.integral_limit);
-                    integral = (integral + e).clamp(-lim, lim);
-                }
-                n.integral = low(integral, 48) as u64;
-                n.e_prev = low(e, 32) as u32;
-                n.primed = true;
-                n.sum = 0;
+                // Rounding to nearest: the sum starts at a half.
+                n.sum = 1 << (OUT_SHIFT - 1);
                 n.acc = 0;
-                let (mag, neg) = self.operand(0, e, n.integral, n.f);
-                n.mag = mag;
-                n.neg = neg;
+                n.mag = e.unsigned_abs() as u64;
+                n.neg = e < 0;
                 n.gain = self.gains[0];
                 n.step0 = false;
                 n.term = 0;
                 n.digit = 0;
             } else if !self.fin {
                 let (k, t) = (u32::from(self.digit), u32::from(self.term));
+                let e = sext(u128::from(self.e), 32);
+                let f = sext(u128::from(self.f), 48);
+                match (t, k) {
+                    // Δ, I + e, F >> k and whether the integrator holds.
+                    (0, 0) => {
+                        let e_prev = sext(u128::from(self.e_prev), 32);
+                        n.delta = low(if self.primed { e - e_prev } else { 0 }, 33) as u64;
+                        n.e_prev = self.e;
+                        n.primed = true;
+                        n.i_sum = low(sext(u128::from(self.integral), 48) + e, 49) as u64;
+                        n.hold = (self.sat_hi && e > 0) || (self.sat_lo && e < 0);
+                        n.d_filt = low(f >> self.d_filter, 48) as u64;
+                    }
+                    // I = clamp(I + e) unless held; F −= F >> k.
+                    (0, 1) => {
+                        if !self.hold {
+                            let lim = i128::from(self.integral_limit);
+                            let i_sum = sext(u128::from(self.i_sum), 49);
+                            n.integral = low(i_sum.clamp(-lim, lim), 48) as u64;
+                        }
+                        n.f = low(f - sext(u128::from(self.d_filt), 48), 48) as u64;
+                    }
+                    // F += Δ.
+                    (0, 2) => n.f = low(f + sext(u128::from(self.delta), 33), 48) as u64,
+                    _ => {}
+                }
                 if k <= DIGITS {
                     // The last digit's registered products into the accumulator (from clock 1).
                     if k >= 1 {
@@ -300,6 +337,10 @@ impl Rtl {
                         let m = |j: u32| (self.mag >> (16 * j)) & 0xffff;
                         n.prods = [g * m(0), g * m(1), g * m(2), g * m(3)];
                     }
+                    // The next term's operand, a clock before it starts.
+                    if k == DIGITS {
+                        n.op = low(self.operand(t + 1), 64) as u64;
+                    }
                     n.digit = self.digit + 1;
                 } else {
                     // The term into the sum; the next term's operand and gain.
@@ -312,9 +353,9 @@ impl Rtl {
                     n.acc = 0;
                     n.digit = 0;
                     if t + 1 < TERMS {
-                        let (mag, neg) = self.operand(t + 1, 0, self.integral, self.f);
-                        n.mag = mag;
-                        n.neg = neg;
+                        let op = sext(u128::from(self.op), 64);
+                        n.mag = op.unsigned_abs() as u64;
+                        n.neg = op < 0;
                         n.gain = self.gains[t as usize + 1];
                         n.term = self.term + 1;
                     } else {
@@ -323,8 +364,7 @@ impl Rtl {
                 }
             } else {
                 // Finish: round, saturate.
-                let sum = sext(self.sum, 116);
-                let u = (sum + (1 << (OUT_SHIFT - 1))) >> OUT_SHIFT;
+                let u = sext(self.sum, 116) >> OUT_SHIFT;
                 let lim = i128::from(self.output_limit);
                 n.sat_hi = u > lim;
                 n.sat_lo = u < -lim;

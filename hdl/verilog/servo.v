@@ -20,6 +20,12 @@ reg [47:0] f_q = 48'd0;              // the derivative filter's state F (the ope
 reg [47:0] i_q = 48'd0;              // the integrator
 reg [31:0] eprev_q = 32'd0;
 reg primed = 1'b0;                   // a sample since the amplifier came on
+reg [31:0] e_q = 32'd0;              // the sample's e = sat32(e48)
+// Term 0's first clocks update D and the integrator (read from term 1's operand on):
+reg [32:0] delta_q = 33'd0;          // Δ = e − e_prev (0 on the first sample)
+reg [47:0] dfilt_q = 48'd0;          // F >>> k, the filter's leak
+reg [48:0] isum_q = 49'd0;           // I + e
+reg hold_q = 1'b0;                   // the integrator holds (the output was clamped its way)
 reg sat_hi = 1'b0, sat_lo = 1'b0;    // the last output was clamped
 reg [63:0] mag_q = 64'd0;            // the term's operand: magnitude, sign
 reg neg_q = 1'b0;
@@ -39,6 +45,10 @@ reg [INTEGRAL_LIMIT_BITS-1:0] ilim_q = {INTEGRAL_LIMIT_BITS{1'b0}};
 reg [OUTPUT_LIMIT_BITS-1:0] olim_q = {OUTPUT_LIMIT_BITS{1'b0}};
 reg [FOLLOWING_LIMIT_BITS-1:0] flim_q = {FOLLOWING_LIMIT_BITS{1'b0}};
 reg [D_FILTER_BITS-1:0] dfk_q = {D_FILTER_BITS{1'b0}};
+// ... and the limits' negations, latched with them (each compare is then one carry chain).
+reg [48:0] flim_neg_q = 49'd0;       // −(FOLLOWING_LIMIT << {{E_FRAC}})
+reg [48:0] ilim_neg_q = 49'd0;       // −INTEGRAL_LIMIT
+reg [16:0] olim_neg_q = 17'd0;       // −OUTPUT_LIMIT
 reg [15:0] duty_q = 16'd0;
 reg fault_q = 1'b0, overrun_q = 1'b0;
 reg [31:0] peak_q = 32'd0;
@@ -47,52 +57,64 @@ reg [31:0] peak_q = 32'd0;
 wire due = tick && (servo_period != {SERVO_PERIOD_BITS{1'b0}})
    && (divider == {SERVO_PERIOD_BITS{1'b0}});
 wire [47:0] e48_now = ref_position - {count, 16'h8000};   // count n: the centre of cell n
+// e = sat32(e48), taken with it.
+wire e_sat_hi = !e48_now[47] && (e48_now[46:31] != 16'd0);
+wire e_sat_lo = e48_now[47] && (e48_now[46:31] != 16'hffff);
+wire [31:0] e_sat = e_sat_hi ? 32'h7fff_ffff : (e_sat_lo ? 32'h8000_0000 : e48_now[31:0]);
 
-// Step 0: saturation, following check, D and the integrator.
-wire e_sat_hi = !e48_q[47] && (e48_q[46:31] != 16'd0);
-wire e_sat_lo = e48_q[47] && (e48_q[46:31] != 16'hffff);
-wire [31:0] e_sat = e_sat_hi ? 32'h7fff_ffff : (e_sat_lo ? 32'h8000_0000 : e48_q[31:0]);
-wire [47:0] e48_abs = e48_q[47] ? (~e48_q + 48'd1) : e48_q;       // |-2^47| = 2^47 fits
-wire fault_now = e48_abs > {flim_q, 16'd0};
-wire [31:0] e_abs = e_sat[31] ? (~e_sat + 32'd1) : e_sat;          // 2^31 fits
-wire [32:0] delta = primed ? ({e_sat[31], e_sat} - {eprev_q[31], eprev_q}) : 33'd0;
+// Step 0: the following check (|e48| > L as e48 > L or e48 < −L), the peak (|e| > peak as
+// peak − e < 0 or peak + e < 0) and the first term's operand |e|.
+wire fault_now = e48_q[47] ? ($signed({e48_q[47], e48_q}) < $signed(flim_neg_q))
+   : (e48_q > {flim_q, 16'd0});
+/* verilator lint_off UNUSEDSIGNAL */ // only their signs are read
+wire [32:0] peak_minus_e = {1'b0, peak_q} - {e_q[31], e_q};
+wire [32:0] peak_plus_e = {1'b0, peak_q} + {e_q[31], e_q};
+/* verilator lint_on UNUSEDSIGNAL */
+wire above_peak = e_q[31] ? peak_plus_e[32] : peak_minus_e[32];
+wire [31:0] e_abs = e_q[31] ? (~e_q + 32'd1) : e_q;                // 2^31 fits
+
+// Term 0's digit clocks 0-2: Δ, I + e, F >>> k; then I = clamp(I + e) unless held and
+// F −= F >>> k; then F += Δ: F + Δ − (F >>> k) in all.
 wire [47:0] d_filt = $signed(f_q) >>> dfk_q;                       // F >>> k
-wire [47:0] f_next = f_q + {{15{delta[32]}}, delta} - d_filt; // F + Δ − (F >>> k)
-wire hold = (sat_hi && !e_sat[31] && (e_sat != 32'd0)) || (sat_lo && e_sat[31]);
-wire [48:0] i_sum = {i_q[47], i_q} + {{17{e_sat[31]}}, e_sat};
-wire [48:0] i_lim = {1'b0, ilim_q};
-wire [48:0] i_neg_lim = ~i_lim + 49'd1;
-wire i_over = !i_sum[48] && (i_sum > i_lim);
-wire i_under = i_sum[48] && ($signed(i_sum) < $signed(i_neg_lim));
-wire [47:0] i_next = hold ? i_q : (i_over ? i_lim[47:0] : (i_under ? i_neg_lim[47:0] : i_sum[47:0]));
+wire hold = (sat_hi && !e_q[31] && (e_q != 32'd0)) || (sat_lo && e_q[31]);
+wire i_over = !isum_q[48] && (isum_q > {1'b0, ilim_q});
+wire i_under = isum_q[48] && ($signed(isum_q) < $signed(ilim_neg_q));
+wire [47:0] i_next = hold_q ? i_q : (i_over ? ilim_q : (i_under ? ilim_neg_q[47:0] : isum_q[47:0]));
+wire first_term = (term == 3'd0);
 
-// The next term's operand (sign-extended to 64 bits) and gain: term 0 on step 0, else term + 1.
-wire [2:0] next_term = step0 ? 3'd0 : term + 3'd1;
+// The next term's operand (sign-extended to 64 bits), registered on the clock before the term
+// starts (op_q), and its gain. Term 0's operand is e, its magnitude e_abs (step 0).
+wire [2:0] next_term = term + 3'd1;
 reg [63:0] op;
 reg [47:0] next_gain;
 always @(*) begin
    case (next_term)
-   3'd0: begin op = {{32{e_sat[31]}}, e_sat}; next_gain = kp_q; end
    3'd1: begin op = {{16{i_q[47]}}, i_q}; next_gain = ki_q; end
-   3'd2: begin op = {{16{d_filt[47]}}, d_filt}; next_gain = kd_q; end   // F updated on step 0
+   3'd2: begin op = {{16{d_filt[47]}}, d_filt}; next_gain = kd_q; end   // F updated in term 0
    3'd3: begin op = {{8{vs_q[55]}}, vs_q}; next_gain = kv_q; end
    default: begin op = as_q; next_gain = ka_q; end
    endcase
 end
-wire [63:0] op_mag = op[63] ? (~op + 64'd1) : op;                   // |-2^63| = 2^63 fits
+reg [63:0] op_q = 64'd0;
+wire [63:0] op_mag = op_q[63] ? (~op_q + 64'd1) : op_q;             // |-2^63| = 2^63 fits
 
 // One gain digit (most significant first) times the magnitude: four 16 x 16 products,
 // registered; added to the accumulator on the next clock.
 wire [15:0] g = (digit == 3'd0) ? gain_q[47:32] : ((digit == 3'd1) ? gain_q[31:16] : gain_q[15:0]);
-wire [79:0] partial = {16'd0, p2, p0} + {p3, p1, 16'd0};
-wire [111:0] acc_next = {acc_q[95:0], 16'd0} + {32'd0, partial};
+// acc = (acc << 16) + {p2, p0} + {p3, p1} << 16: three operands, added carry-save (their
+// bitwise sum and carries, then one carry chain).
+wire [111:0] acc_x = {acc_q[95:0], 16'd0};
+wire [111:0] acc_y = {48'd0, p2, p0};
+wire [111:0] acc_z = {32'd0, p3, p1, 16'd0};
+wire [110:0] acc_carries = (acc_x[110:0] & acc_y[110:0]) | (acc_x[110:0] & acc_z[110:0])
+   | (acc_y[110:0] & acc_z[110:0]);   // (the carry out of bit 111 leaves the 112 bits)
+wire [111:0] acc_next = (acc_x ^ acc_y ^ acc_z) + {acc_carries, 1'b0};
 
-// Finish: round to nearest (halves up): (sum + 2^47) >>> 48 = sum[115:48] + sum[47]; saturate.
-wire [67:0] u = sum_q[115:48] + {67'd0, sum_q[47]};
-wire [67:0] lim = {52'd0, olim_q};
-wire [67:0] neg_lim = ~lim + 68'd1;
-wire u_hi = $signed(u) > $signed(lim);
-wire u_lo = $signed(u) < $signed(neg_lim);
+// Finish: round to nearest (halves up): the sum starts at 2^{{HALF}}, so u = sum >>> {{OUT_SHIFT}};
+// saturate.
+wire [67:0] u = sum_q[115:48];
+wire u_hi = $signed(u) > $signed({52'd0, olim_q});
+wire u_lo = $signed(u) < $signed({{51{olim_neg_q[16]}}, olim_neg_q});
 
 always @(posedge clock) begin
    fault_q <= 1'b0;
@@ -116,9 +138,15 @@ always @(posedge clock) begin
       i_q <= 48'd0;
       eprev_q <= 32'd0;
       primed <= 1'b0;
+      e_q <= 32'd0;
+      delta_q <= 33'd0;
+      dfilt_q <= 48'd0;
+      isum_q <= 49'd0;
+      hold_q <= 1'b0;
       sat_hi <= 1'b0;
       sat_lo <= 1'b0;
       mag_q <= 64'd0;
+      op_q <= 64'd0;
       neg_q <= 1'b0;
       gain_q <= 48'd0;
       acc_q <= 112'd0;
@@ -130,6 +158,7 @@ always @(posedge clock) begin
       if (due && busy) overrun_q <= 1'b1;
       else if (due) begin
          e48_q <= e48_now;
+         e_q <= e_sat;
          vs_q <= velocity;
          as_q <= accel;
          kp_q <= kp;
@@ -141,28 +170,41 @@ always @(posedge clock) begin
          olim_q <= output_limit;
          flim_q <= following_limit;
          dfk_q <= d_filter;
+         flim_neg_q <= ~{1'b0, following_limit, 16'd0} + 49'd1;
+         ilim_neg_q <= ~{1'b0, integral_limit} + 49'd1;
+         olim_neg_q <= ~{1'b0, output_limit} + 17'd1;
          busy <= 1'b1;
          step0 <= 1'b1;
       end
       if (busy) begin
          if (step0) begin
             fault_q <= fault_now;
-            if (!start && (e_abs > peak_q)) peak_q <= e_abs;
-            f_q <= f_next;
-            i_q <= i_next;
-            eprev_q <= e_sat;
-            primed <= 1'b1;
-            sum_q <= 116'd0;
+            if (!start && above_peak) peak_q <= e_abs;
+            sum_q <= 116'd1 << {{HALF}};
             acc_q <= 112'd0;
-            mag_q <= op_mag;
-            neg_q <= op[63];
-            gain_q <= next_gain;
+            mag_q <= {32'd0, e_abs};
+            neg_q <= e_q[31];
+            gain_q <= kp_q;
             step0 <= 1'b0;
             term <= 3'd0;
             digit <= 3'd0;
          end else if (!fin) begin
+            if (first_term && (digit == 3'd0)) begin
+               delta_q <= primed ? ({e_q[31], e_q} - {eprev_q[31], eprev_q}) : 33'd0;
+               eprev_q <= e_q;
+               primed <= 1'b1;
+               isum_q <= {i_q[47], i_q} + {{17{e_q[31]}}, e_q};
+               hold_q <= hold;
+               dfilt_q <= d_filt;
+            end
+            if (first_term && (digit == 3'd1)) begin
+               i_q <= i_next;
+               f_q <= f_q - dfilt_q;
+            end
+            if (first_term && (digit == 3'd2)) f_q <= f_q + {{15{delta_q[32]}}, delta_q};
             if (digit != 3'd{{SUM_CLOCK}}) begin
                if (digit != 3'd0) acc_q <= acc_next;
+               if (digit == 3'd{{DIGITS}}) op_q <= op;
                if (digit < 3'd{{DIGITS}}) begin
                   p0 <= g * mag_q[15:0];
                   p1 <= g * mag_q[31:16];
@@ -176,7 +218,7 @@ always @(posedge clock) begin
                digit <= 3'd0;
                if (term != 3'd{{LAST_TERM}}) begin
                   mag_q <= op_mag;
-                  neg_q <= op[63];
+                  neg_q <= op_q[63];
                   gain_q <= next_gain;
                   term <= term + 3'd1;
                end else fin <= 1'b1;
@@ -184,7 +226,7 @@ always @(posedge clock) begin
          end else begin
             sat_hi <= u_hi;
             sat_lo <= u_lo;
-            duty_q <= u_hi ? olim_q : (u_lo ? neg_lim[15:0] : u[15:0]);
+            duty_q <= u_hi ? olim_q : (u_lo ? olim_neg_q[15:0] : u[15:0]);
             busy <= 1'b0;
             fin <= 1'b0;
          end
