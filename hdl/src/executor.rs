@@ -155,12 +155,14 @@ snapgen_spec::with_motion_core_ports!(executor_block! {
             following_fault: Bit,
             /// The controller skipped a sample.
             servo_overrun_in: Bit,
-            /// The parameter whose value `read_value` gives (the reply transmitter's head).
+            /// The parameter whose value `read_value` gives a clock later (the reply
+            /// transmitter's CONFIG reply).
             read_param: Bits<8>,
         }
         outputs {
             /// TELEMETRY_PERIOD and WATCHDOG_MS are the executor's own; the value of
-            /// parameter `read_param` (combinational; 0 for an unknown one).
+            /// parameter `read_param` named on the clock before (registered; 0 for an unknown
+            /// one).
             read_value: Bits<D_BITS>,
             /// The axis state (the status block's byte).
             state: Bits<8>,
@@ -336,15 +338,23 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         names(&|p| p.settable == Settable::AtRest),
         names(&|p| p.settable == Settable::Disabled),
     );
-    let (mut over, mut set, mut regs, mut holds) =
-        (String::new(), String::new(), String::new(), String::new());
+    let (mut over, mut set, mut regs, mut holds, mut select) = (
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+    );
     let (mut resets, mut clocked, mut outs, mut read) =
         (String::new(), String::new(), String::new(), String::new());
-    for p in PARAMS {
+    for (k, p) in PARAMS.iter().enumerate() {
         let (name, bits) = (p.register, p.bits);
         let pn = format!("P_{}", p.name);
         over.push_str(&format!("{pn}: cfg_over = {};\n", above_max(p.param)));
-        set.push_str(&format!("{pn}: n_{name} = cfg_value[{bits}-1:0];\n"));
+        select.push_str(&format!("pre_cfg_sel[{k}] <= cfg_param == {pn};\n"));
+        set.push_str(&format!(
+            "if (pre_cfg_sel[{k}]) n_{name} = cfg_value[{bits}-1:0];\n"
+        ));
         regs.push_str(&format!(
             "reg [{bits}-1:0] {name}_q = {bits}'d0, n_{name};   // {}\n",
             p.name
@@ -358,7 +368,7 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         resets.push_str(&format!("{name}_q <= {bits}'d{};\n", p.reset_value(design)));
         clocked.push_str(&format!("{name}_q <= n_{name};\n"));
         read.push_str(&format!(
-            "{pn}: read_value = {};\n",
+            "{pn}: read_value_q <= {};\n",
             if bits as usize == D_BITS {
                 format!("{name}_q")
             } else {
@@ -377,6 +387,7 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         .block("param_over", over)
         .block("param_registers", regs)
         .block("param_holds", holds)
+        .block("param_select", select)
         .block("param_set", set)
         .block("param_resets", resets)
         .block("param_clocked", clocked)
@@ -388,6 +399,14 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
     params.extend([
         LocalParam::new("CLOCKS_PER_MS", 32, u64::from(d.clocks_per_ms)),
         LocalParam::new("SWAP_MIN_LEAD", 64, SWAP_MIN_LEAD as u64),
+        // The bits SWAP_MIN_LEAD needs: the lateness check compares those and zero-detects
+        // the rest.
+        LocalParam::new(
+            "LEAD_BITS",
+            32,
+            u64::from(u64::BITS - (SWAP_MIN_LEAD as u64).leading_zeros()),
+        ),
+        LocalParam::new("PARAM_COUNT", 32, PARAMS.len() as u64),
         // Compared with a byte of the payload.
         LocalParam::new(
             "MAX_SEGMENTS",

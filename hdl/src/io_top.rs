@@ -206,7 +206,7 @@ impl Logic for IoTop {
         self.exec.encoder_errors.next = self.encoder.errors.val();
         self.exec.following_fault.next = self.servo.fault.val();
         self.exec.servo_overrun_in.next = self.servo.overrun.val();
-        self.exec.read_param.next = self.queue.head_aux.val();
+        self.exec.read_param.next = self.reply_tx.read_param.val();
         self.exec.heading_pos.next = self.core.heading_pos.val();
         self.exec.heading_neg.next = self.core.heading_neg.val();
         self.exec.queue_full.next = self.queue.full.val();

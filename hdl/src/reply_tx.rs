@@ -1,9 +1,11 @@
 //! The reply transmitter (the reference is `snapgen_model::io::reply_tx::ReplyTx`). When idle
-//! it takes the reply queue's head, or else a pending telemetry frame, reads its payload from
-//! the live values of that clock (a reply reports the device as it is when the reply starts:
-//! docs/PROTOCOL.md), and writes the frame — start byte, length, code, sequence, payload, CRC
-//! low then high — into the transmit FIFO one byte per clock while the FIFO is not full.
-//! Frames are never interleaved; telemetry waits while a reply is queued.
+//! it takes the reply queue's head, or else a pending telemetry frame, and writes the frame —
+//! start byte, length, code, sequence, payload, CRC low then high — into the transmit FIFO one
+//! byte per clock while the FIFO is not full; it reads the payload from the live values
+//! [`PAYLOAD_DELAY`] clocks after the start, a CONFIG reply's value a clock before that from
+//! the executor, which registers the parameter `read_param` names (a reply reports the device
+//! as it is when the reply starts: docs/PROTOCOL.md). Frames are never interleaved; telemetry
+//! waits while a reply is queued.
 //!
 //! Every payload is laid out by its table in `snapgen_spec::fields` (`IDENTITY_FIELDS`,
 //! `STATE_FIELDS`, `CONFIG_FIELDS`; the status block arrives laid out), and the CRC is the
@@ -19,6 +21,8 @@ use snapgen_spec::fields::{
 };
 use snapgen_spec::wire::CRC_INIT;
 
+use snapgen_model::io::reply_tx::PAYLOAD_DELAY;
+
 use crate::crc16::crc16_function;
 use crate::template::{fill, Holes};
 
@@ -27,6 +31,9 @@ const TEMPLATE: &str = include_str!("../verilog/reply_tx.v");
 use crate::protocol_v::{self, KIND_BITS};
 use crate::status_block::STATUS_BITS;
 use crate::{D_BITS, X_BITS};
+
+// The Verilog reads the CONFIG value on one clock and the payload on the next.
+const _: () = assert!(PAYLOAD_DELAY == 2);
 
 /// The longest payload (the `STATE` reply).
 pub const MAX_PAYLOAD: usize = {
@@ -66,8 +73,8 @@ pub struct ReplyTx {
     pub stop_jerk: Signal<In, Bits<D_BITS>>,
     /// STOP_ACCEL.
     pub stop_accel: Signal<In, Bits<D_BITS>>,
-    /// The value of the parameter `head_aux` names (the executor's `read_value`): a CONFIG
-    /// reply's value.
+    /// The value of the parameter `read_param` named on the clock before (the executor's
+    /// registered `read_value`): a CONFIG reply's value.
     pub config_value: Signal<In, Bits<D_BITS>>,
     /// Ticks since reset.
     pub ticks: Signal<In, Bits<64>>,
@@ -81,6 +88,8 @@ pub struct ReplyTx {
     pub j: Signal<In, Bits<D_BITS>>,
     /// Take the queue's head now (combinational).
     pub pop: Signal<Out, Bit>,
+    /// The parameter a CONFIG reply being written reads (registered at its start).
+    pub read_param: Signal<Out, Bits<8>>,
     /// Write `fifo_data` now (combinational).
     pub fifo_write: Signal<Out, Bit>,
     /// The byte.
@@ -113,6 +122,7 @@ impl ReplyTx {
             a: Default::default(),
             j: Default::default(),
             pop: Default::default(),
+            read_param: Default::default(),
             fifo_write: Default::default(),
             fifo_data: Default::default(),
             _identity: identity,
@@ -131,6 +141,7 @@ impl Logic for ReplyTx {
 
     fn connect(&mut self) {
         self.pop.connect();
+        self.read_param.connect();
         self.fifo_write.connect();
         self.fifo_data.connect();
     }
@@ -187,13 +198,13 @@ pub fn reply_tx_verilog(id: &Identity) -> String {
         other => panic!("state field {other} has no source"),
     });
     let config = payload(&CONFIG_FIELDS, |name| match name {
-        "param" => ("head_aux".into(), 8),
+        "param" => ("aux_q".into(), 8),
         "value" => ("config_value".into(), D_BITS),
         other => panic!("config field {other} has no source"),
     });
     let nak = payload(&NAK_FIELDS, |name| match name {
-        "cmd" => ("head_cmd".into(), 8),
-        "reason" => ("head_aux".into(), 8),
+        "cmd" => ("cmd_q".into(), 8),
+        "reason" => ("aux_q".into(), 8),
         other => panic!("nak field {other} has no source"),
     });
     let pad = |expr: &str, bytes: usize| {
@@ -213,6 +224,7 @@ pub fn reply_tx_verilog(id: &Identity) -> String {
         .value("STATE", state)
         .value("CONFIG", config)
         .value("PAYLOAD_TOP", 8 * MAX_PAYLOAD - 1)
+        .value("PAYLOAD_DELAY", PAYLOAD_DELAY)
         .value("PAYLOAD_BITS", 8 * MAX_PAYLOAD)
         .value("ID_BYTES", payload_bytes(&IDENTITY_FIELDS))
         .value(
@@ -220,7 +232,7 @@ pub fn reply_tx_verilog(id: &Identity) -> String {
             pad("identity_payload", payload_bytes(&IDENTITY_FIELDS)),
         )
         .value("ACK_BYTES", AckPayload::BYTES)
-        .value("ACK_PADDED", pad("head_cmd", AckPayload::BYTES))
+        .value("ACK_PADDED", pad("cmd_q", AckPayload::BYTES))
         .value("NAK_BYTES", NakPayload::BYTES)
         .value("NAK_PADDED", pad(&nak, NakPayload::BYTES))
         .value("STATUS_BYTES", status_bytes)

@@ -99,80 +99,144 @@ wire jerk_pair_valid = (cfg_value != {D_BITS{1'b0}}) && (cfg_value <= stop_accel
 wire accel_pair_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= cfg_value);
 wire cfg_pair_valid = (cfg_param == P_STOP_JERK) ? jerk_pair_valid
    : ((cfg_param == P_STOP_ACCEL) ? accel_pair_valid : 1'b1);
-// SWAP_AT: how far its tick lies beyond the time base (signed, wrap-safe), registered every
-// clock (the payload is complete a byte before the frame is): one clock old when the frame is
-// executed, and the core arms one clock later, so the time base may have ticked twice by then;
-// the core wants three ticks of lead.
-reg [TIME_BITS-1:0] swap_lead_q = {TIME_BITS{1'b0}};
-always @(posedge clock) swap_lead_q <= reset ? {TIME_BITS{1'b0}} : (swap_tick - ticks);
-wire swap_late = swap_lead_q[TIME_BITS-1] || (swap_lead_q < SWAP_MIN_LEAD);
+
+// ---- The frame's decode, a clock ahead -------------------------------------------------------
+// The command, its length and its payload are complete two bytes before the frame is checked,
+// and the registers they are checked against (the parameters) change only when a frame is
+// executed (more than a clock before the next one is) or by a reset (which the frame receiver
+// shares): what depends on them alone is registered on every clock and is exact on the
+// frame's clock (the state, the core's outputs and the received CRC are read on that clock
+// itself).
+reg pre_known = 1'b0;                            // the command is in the table
+reg pre_len_ok = 1'b0;                           // ... and has its payload length
+reg pre_has_effect = 1'b0;
+reg pre_bad_argument = 1'b0;                     // its arguments are refused in any state
+reg pre_cfg_at_rest = 1'b0;                      // CONFIGURE: settable only at rest
+reg pre_cfg_disabled = 1'b0;                     // ... only while Disabled
+reg pre_cfg_pair_bad = 1'b0;                     // ... the stop limits it would leave invalid
+reg pre_power_on = 1'b0;                         // POWER 1
+reg pre_seg_first = 1'b0;                        // LOAD_SEGMENT of segment 0
+reg pre_seg_pos = 1'b0, pre_seg_neg = 1'b0;      // ... whose snap heads + or −
+reg pre_limits_valid = 1'b0;                     // the stop limits: 0 < jerk <= accel
+reg pre_servo_ready = 1'b0;
+reg [PARAM_COUNT-1:0] pre_cfg_sel = {PARAM_COUNT{1'b0}};   // CONFIGURE's parameter, one-hot
+always @(posedge clock) begin
+   pre_known <= known;
+   pre_len_ok <= known && (len == want_len);
+   pre_has_effect <= has_effect;
+   case (cmd)
+   CMD_LOAD_SEGMENT: pre_bad_argument <= (seg_index >= MAX_SEGMENTS) || (seg_ticks == {TICK_BITS{1'b0}});
+   CMD_COMMIT: pre_bad_argument <= arg0 > MAX_SEGMENTS;
+   CMD_CONFIGURE: pre_bad_argument <= !param_known(cfg_param) || cfg_value[D_BITS-1] || cfg_over;
+   CMD_READ_CONFIG: pre_bad_argument <= !param_known(arg0);
+   CMD_POWER: pre_bad_argument <= arg0 > 8'd1;
+   default: pre_bad_argument <= 1'b0;
+   endcase
+   pre_cfg_at_rest <= param_at_rest(cfg_param);
+   pre_cfg_disabled <= param_disabled(cfg_param);
+   pre_cfg_pair_bad <= ((cfg_param == P_STOP_JERK) || (cfg_param == P_STOP_ACCEL)) && !cfg_pair_valid;
+   pre_power_on <= arg0 == 8'd1;
+   pre_seg_first <= seg_index[ADDR_BITS-1:0] == {ADDR_BITS{1'b0}};
+   pre_seg_pos <= !seg_snap[D_BITS-1] && (seg_snap != {D_BITS{1'b0}});
+   pre_seg_neg <= seg_snap[D_BITS-1];
+   pre_limits_valid <= stop_limits_valid;
+   pre_servo_ready <= servo_ready;
+   //@ param_select
+end
+
+// SWAP_AT: how far its tick lies beyond the time base (the lead: signed, wrap-safe), checked on
+// every clock and registered (the payload is complete two bytes before the frame is): one clock
+// old when the frame is executed, and the core arms one clock later, so the time base may have
+// ticked twice by then; the core wants three ticks of lead. Late: the lead is negative or its
+// bits above LEAD_BITS are 0 and its low bits below SWAP_MIN_LEAD (no second carry chain after
+// the subtraction).
+wire [TIME_BITS-1:0] swap_lead = swap_tick - ticks;
+reg swap_late_q = 1'b1;
 // The core compares SWAP_BITS bits: a tick 2^(SWAP_BITS-1) ticks or more ahead is refused.
-wire swap_far = !swap_lead_q[TIME_BITS-1]
-   && (swap_lead_q[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
+reg swap_far_q = 1'b0;
+always @(posedge clock) begin
+   swap_late_q <= reset || swap_lead[TIME_BITS-1]
+      || ((swap_lead[TIME_BITS-2:LEAD_BITS] == {(TIME_BITS-1-LEAD_BITS){1'b0}})
+         && (swap_lead[LEAD_BITS-1:0] < SWAP_MIN_LEAD[LEAD_BITS-1:0]));
+   swap_far_q <= !reset && !swap_lead[TIME_BITS-1]
+      && (swap_lead[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
+end
 wire [SWAP_BITS-1:0] swap_before = swap_tick[SWAP_BITS-1:0] - 1'b1;   // the core's swap_last: T − 1
 wire toward_limit = (first_pos_q && limit_pos) || (first_neg_q && limit_neg);
 // ErrorStop with the amplifier off and the axis at rest: nothing can move, as while Disabled,
 // so the parameters settable only while Disabled may be set (INPUT_POLARITY set back).
 wire inert = (state_q == S_ERROR_STOP) && !amplifier_q && !moving;
-reg [7:0] reason;
-always @(*) begin
-   reason = 8'd0;
-   case (cmd)
-   CMD_LOAD_SEGMENT:
-      if ((seg_index >= MAX_SEGMENTS) || (seg_ticks == {TICK_BITS{1'b0}})) reason = R_BAD_ARGUMENT;
-      else if (swap_pending) reason = R_SWAP_PENDING;
-   CMD_COMMIT:
-      if (arg0 > MAX_SEGMENTS) reason = R_BAD_ARGUMENT;
-      else if (swap_pending) reason = R_SWAP_PENDING;
-   CMD_START:
-      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
-      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
-      else if (state_q == S_STOPPING) reason = R_STOPPING;
-      else if (busy) reason = R_BUSY;
-      else if (stopping) reason = R_STOPPING;
-      else if (swap_pending) reason = R_SWAP_PENDING;
-      else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
-      else if (!rested) reason = R_BUSY;
-      else if (toward_limit) reason = R_LIMIT;
-   CMD_SWAP_AT:
-      if (swap_far) reason = R_BAD_ARGUMENT;
-      else if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
-      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
-      else if (state_q == S_STOPPING) reason = R_STOPPING;
-      else if (stopping) reason = R_STOPPING;
-      else if (swap_pending) reason = R_SWAP_PENDING;
-      else if (standby_count == {INDEX_BITS{1'b0}}) reason = R_NO_PROGRAM;
-      else if (swap_late) reason = R_LATE;
-      else if (rested && !busy && toward_limit) reason = R_LIMIT;
-   CMD_STOP:
-      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
-   CMD_HALT:
-      if (state_q == S_DISABLED) reason = R_NOT_ENABLED;
-      else if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
-      else if (state_q == S_STOPPING) reason = R_STOPPING;
-   CMD_CONFIGURE:
-      if (!param_known(cfg_param) || cfg_value[D_BITS-1] || cfg_over) reason = R_BAD_ARGUMENT;
-      else if (param_at_rest(cfg_param) && moving) reason = R_BUSY;
-      else if (param_disabled(cfg_param) && (state_q != S_DISABLED) && !inert) reason = R_NOT_DISABLED;
-      else if ((state_q != S_DISABLED) && ((cfg_param == P_STOP_JERK) || (cfg_param == P_STOP_ACCEL))
-            && !cfg_pair_valid) reason = R_BAD_ARGUMENT;
-   CMD_READ_CONFIG:
-      if (!param_known(arg0)) reason = R_BAD_ARGUMENT;
-   CMD_POWER:
-      if (arg0 > 8'd1) reason = R_BAD_ARGUMENT;
-      else if (arg0 == 8'd1) begin
-         if (state_q == S_ERROR_STOP) reason = R_AXIS_ERROR;
-         else if ((state_q == S_DISABLED) && (!stop_limits_valid || !servo_ready))
-            reason = R_NOT_CONFIGURED;
-      end else if (moving) reason = R_BUSY;
-   CMD_RESET:
-      if ((state_q == S_ERROR_STOP) && (moving || estop)) reason = R_AXIS_ERROR;
+// Why command c would be refused in axis state st on this clock (0: it is not). Evaluated for
+// the frame's own command (`reason`, the reply's) and for each command whose effect it gates
+// (`taken`, below: that command's conditions alone, without the multiplexer over all commands,
+// a shorter path to the registers it writes). (The state is an argument: Yosys evaluates a
+// function whose arguments are all constants at elaboration, and this one reads live signals.)
+function automatic [7:0] refusal(input [7:0] c, input [STATE_BITS-1:0] st);
+begin
+   refusal = 8'd0;
+   case (c)
+      CMD_LOAD_SEGMENT:
+         if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
+         else if (swap_pending) refusal = R_SWAP_PENDING;
+      CMD_COMMIT:
+         if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
+         else if (swap_pending) refusal = R_SWAP_PENDING;
+      CMD_START:
+         if (st == S_DISABLED) refusal = R_NOT_ENABLED;
+         else if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
+         else if (st == S_STOPPING) refusal = R_STOPPING;
+         else if (busy) refusal = R_BUSY;
+         else if (stopping) refusal = R_STOPPING;
+         else if (swap_pending) refusal = R_SWAP_PENDING;
+         else if (standby_count == {INDEX_BITS{1'b0}}) refusal = R_NO_PROGRAM;
+         else if (!rested) refusal = R_BUSY;
+         else if (toward_limit) refusal = R_LIMIT;
+      CMD_SWAP_AT:
+         if (swap_far_q) refusal = R_BAD_ARGUMENT;
+         else if (st == S_DISABLED) refusal = R_NOT_ENABLED;
+         else if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
+         else if (st == S_STOPPING) refusal = R_STOPPING;
+         else if (stopping) refusal = R_STOPPING;
+         else if (swap_pending) refusal = R_SWAP_PENDING;
+         else if (standby_count == {INDEX_BITS{1'b0}}) refusal = R_NO_PROGRAM;
+         else if (swap_late_q) refusal = R_LATE;
+         else if (rested && !busy && toward_limit) refusal = R_LIMIT;
+      CMD_STOP:
+         if (st == S_DISABLED) refusal = R_NOT_ENABLED;
+      CMD_HALT:
+         if (st == S_DISABLED) refusal = R_NOT_ENABLED;
+         else if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
+         else if (st == S_STOPPING) refusal = R_STOPPING;
+      CMD_CONFIGURE:
+         if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
+         else if (pre_cfg_at_rest && moving) refusal = R_BUSY;
+         else if (pre_cfg_disabled && (st != S_DISABLED) && !inert) refusal = R_NOT_DISABLED;
+         else if ((st != S_DISABLED) && pre_cfg_pair_bad) refusal = R_BAD_ARGUMENT;
+      CMD_READ_CONFIG:
+         if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
+      CMD_POWER:
+         if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
+         else if (pre_power_on) begin
+            if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
+            else if ((st == S_DISABLED) && (!pre_limits_valid || !pre_servo_ready))
+               refusal = R_NOT_CONFIGURED;
+         end else if (moving) refusal = R_BUSY;
+      CMD_RESET:
+         if ((st == S_ERROR_STOP) && (moving || estop)) refusal = R_AXIS_ERROR;
    default: ;
    endcase
 end
+endfunction
+wire [7:0] reason = refusal(cmd, state_q);
 
-wire retry = has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
+wire retry = pre_has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
    && (crc == last_crc_q);
+// The frame is executed: good, answered, of its length, not a retry ...
+wire executes = frame && !bad_crc && !dropped && !queue_full && pre_len_ok && !retry;
+// ... and is command c, not refused in axis state st: c's effect applies.
+function automatic taken(input [7:0] c, input [STATE_BITS-1:0] st);
+   taken = executes && (cmd == c) && (refusal(c, st) == 8'd0);
+endfunction
 wire expired = (watchdog_ms_q != {WATCHDOG_MS_BITS{1'b0}}) && (watchdog_count_q >= watchdog_ms_q);
 // A start, stop or swap the core takes now, or the chain driven on the last clock (the core's
 // at_rest is a register: it tells where the last tick left the chain a clock later).
@@ -274,11 +338,11 @@ always @(*) begin
       n_reply_cmd = cmd;
       n_reply_seq = seq;
       if (queue_full) n_overflow = 1'b1;
-      else if (!known || (len != want_len)) begin
+      else if (!pre_len_ok) begin
          n_bad_frames = bad_frames_q + 16'd1;
          n_reply = 1'b1;
          n_reply_kind = K_NAK;
-         n_reply_aux = known ? R_BAD_LENGTH : R_UNKNOWN_COMMAND;
+         n_reply_aux = pre_known ? R_BAD_LENGTH : R_UNKNOWN_COMMAND;
       end else if (retry) begin
          // A retry: the same answer, no effect.
          n_reply = 1'b1;
@@ -301,75 +365,9 @@ always @(*) begin
             n_reply_kind = K_CONFIG;
             n_reply_aux = arg0;
          end
-         CMD_LOAD_SEGMENT: begin
-            n_write_enable = 1'b1;
-            n_write_address = seg_index[ADDR_BITS-1:0];
-            n_write_ticks = seg_ticks;
-            n_write_snap = seg_snap;
-            if (seg_index[ADDR_BITS-1:0] == {ADDR_BITS{1'b0}}) begin
-               n_first_pos = !seg_snap[D_BITS-1] && (seg_snap != {D_BITS{1'b0}});
-               n_first_neg = seg_snap[D_BITS-1];
-            end
-         end
-         CMD_COMMIT: begin
-            n_count_enable = 1'b1;
-            n_count_value = arg0[INDEX_BITS-1:0];
-         end
-         CMD_START: begin
-            n_start = 1'b1;
-            n_state = S_DISCRETE_MOTION;
-            // The banks swap: the new standby program is empty.
-            n_first_pos = 1'b0;
-            n_first_neg = 1'b0;
-         end
-         CMD_SWAP_AT: begin
-            n_swap = 1'b1;
-            n_swap_last = swap_before;
-            n_state = S_DISCRETE_MOTION;
-            // The banks swap at the tick; no upload is taken before that.
-            n_first_pos = 1'b0;
-            n_first_neg = 1'b0;
-         end
-         CMD_STOP:
-            if (state_q != S_ERROR_STOP) begin
-               n_stop = 1'b1;
-               n_state = S_STOPPING;
-            end
-         CMD_HALT:
-            if ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION)) n_stop = 1'b1;
-         CMD_CONFIGURE: begin
-            case (cfg_param)
-            //@ param_set
-            default: ;
-            endcase
-            if (cfg_param == P_TELEMETRY_PERIOD)
-               n_telemetry_left = cfg_value[TELEMETRY_PERIOD_BITS-1:0];
-         end
-         CMD_POWER:
-            if (arg0 == 8'd1) begin
-               if (state_q == S_DISABLED) begin
-                  n_amplifier = 1'b1;
-                  n_state = S_STANDSTILL;
-                  n_load = 1'b1;                 // MC_Power: the axis holds where it is
-               end
-            end else begin
-               n_amplifier = 1'b0;
-               if (state_q == S_STANDSTILL) n_state = S_DISABLED;
-            end
-         CMD_RESET: begin
-            // The sticky flags clear in any state.
-            n_uart_error = 1'b0;
-            n_overflow = 1'b0;
-            n_servo_overrun = 1'b0;
-            n_enc_seen = encoder_errors;
-            if (state_q == S_ERROR_STOP) begin
-               n_error = E_NONE;
-               n_state = amplifier_q ? S_STANDSTILL : S_DISABLED;
-            end
-         end
          default: ;
          endcase
-         if (has_effect) begin
+         if (pre_has_effect) begin
             n_last_valid = 1'b1;
             n_last_cmd = cmd;
             n_last_seq = seq;
@@ -377,6 +375,72 @@ always @(*) begin
             n_last_kind = n_reply_kind;
             n_last_aux = n_reply_aux;
          end
+      end
+   end
+
+   // The commands' effects, each when it is taken (after the frame's reply, before it in the
+   // model: they write other registers).
+   if (taken(CMD_LOAD_SEGMENT, state_q)) begin
+      n_write_enable = 1'b1;
+      n_write_address = seg_index[ADDR_BITS-1:0];
+      n_write_ticks = seg_ticks;
+      n_write_snap = seg_snap;
+      if (pre_seg_first) begin
+         n_first_pos = pre_seg_pos;
+         n_first_neg = pre_seg_neg;
+      end
+   end
+   if (taken(CMD_COMMIT, state_q)) begin
+      n_count_enable = 1'b1;
+      n_count_value = arg0[INDEX_BITS-1:0];
+   end
+   if (taken(CMD_START, state_q)) begin
+      n_start = 1'b1;
+      n_state = S_DISCRETE_MOTION;
+      // The banks swap: the new standby program is empty.
+      n_first_pos = 1'b0;
+      n_first_neg = 1'b0;
+   end
+   if (taken(CMD_SWAP_AT, state_q)) begin
+      n_swap = 1'b1;
+      n_swap_last = swap_before;
+      n_state = S_DISCRETE_MOTION;
+      // The banks swap at the tick; no upload is taken before that.
+      n_first_pos = 1'b0;
+      n_first_neg = 1'b0;
+   end
+   if (taken(CMD_STOP, state_q) && (state_q != S_ERROR_STOP)) begin
+      n_stop = 1'b1;
+      n_state = S_STOPPING;
+   end
+   if (taken(CMD_HALT, state_q) && ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION)))
+      n_stop = 1'b1;
+   if (taken(CMD_CONFIGURE, state_q)) begin
+      //@ param_set
+      if (cfg_param == P_TELEMETRY_PERIOD)
+         n_telemetry_left = cfg_value[TELEMETRY_PERIOD_BITS-1:0];
+   end
+   if (taken(CMD_POWER, state_q)) begin
+      if (pre_power_on) begin
+         if (state_q == S_DISABLED) begin
+            n_amplifier = 1'b1;
+            n_state = S_STANDSTILL;
+            n_load = 1'b1;                 // MC_Power: the axis holds where it is
+         end
+      end else begin
+         n_amplifier = 1'b0;
+         if (state_q == S_STANDSTILL) n_state = S_DISABLED;
+      end
+   end
+   if (taken(CMD_RESET, state_q)) begin
+      // The sticky flags clear in any state.
+      n_uart_error = 1'b0;
+      n_overflow = 1'b0;
+      n_servo_overrun = 1'b0;
+      n_enc_seen = encoder_errors;
+      if (state_q == S_ERROR_STOP) begin
+         n_error = E_NONE;
+         n_state = amplifier_q ? S_STANDSTILL : S_DISABLED;
       end
    end
 
@@ -522,6 +586,17 @@ always @(posedge clock) begin
    end
 end
 
+// READ_CONFIG's value, for the reply transmitter: the parameter read_param names, registered
+// (0 for an unknown one).
+reg [D_BITS-1:0] read_value_q = {D_BITS{1'b0}};
+always @(posedge clock) begin
+   read_value_q <= {D_BITS{1'b0}};
+   case (read_param)
+   //@ param_read
+   default: ;
+   endcase
+end
+
 always @(*) begin
    write_enable = write_enable_q;
    write_address = write_address_q;
@@ -543,12 +618,7 @@ always @(*) begin
    uart_error = uart_error_q;
    reply_overflow = overflow_q;
    encoder_errors_seen = enc_seen_q;
-   // READ_CONFIG's value, for the reply transmitter.
-   read_value = {D_BITS{1'b0}};
-   case (read_param)
-   //@ param_read
-   default: ;
-   endcase
+   read_value = read_value_q;
    bad_crc_count = bad_crc_q;
    bad_frames_count = bad_frames_q;
    reply = reply_q;

@@ -2,58 +2,51 @@
 // snapgen_hdl fills the values in double braces from the payload layouts (snapgen_spec::fields)
 // and the line //@ crc_function with the CRC step, and puts the codes and kinds it names in front of it as localparams.
 //
-// When idle it takes the reply queue's head, or else a pending telemetry frame, reads its
-// payload from the live values of that clock, and writes the frame (start byte, length, code,
-// sequence, payload, CRC low then high) into the transmit FIFO one byte per clock while the
-// FIFO is not full. The payload is held in a shift register and sent from its low byte.
+// When idle it takes the reply queue's head, or else a pending telemetry frame, and writes the
+// frame (start byte, length, code, sequence, payload, CRC low then high) into the transmit FIFO
+// one byte per clock while the FIFO is not full. The payload is held in a shift register and
+// sent from its low byte. It is read from the live values {{PAYLOAD_DELAY}} clocks after the start (its
+// first byte is written three clocks after that at the earliest), a CONFIG reply's value from the
+// executor's read_value, registered the clock before from the parameter read_param names:
+// a pipeline, so that no path runs from the reply queue through the parameters' multiplexer
+// into the payload in one clock.
 
-// ---- The reply launched on this clock, and its payload (byte 0 in bits 7:0) -------------------
+// ---- The reply launched on this clock: its kind, length and code -----------------------------
 wire launch_head = !active_q && head_valid;
 wire launch_telemetry = !active_q && !head_valid && (pending_q || telemetry);
 wire [KIND_BITS-1:0] kind = launch_head ? head_kind : K_TELEMETRY;
+reg [7:0] new_len;
+reg [7:0] new_code;
+always @(*) begin
+   case (kind)
+   K_IDENTITY: begin new_len = 8'd{{ID_BYTES}}; new_code = RC_IDENTITY; end
+   K_ACK: begin new_len = 8'd{{ACK_BYTES}}; new_code = RC_ACK; end
+   K_NAK: begin new_len = 8'd{{NAK_BYTES}}; new_code = RC_NAK; end
+   K_STATUS: begin new_len = 8'd{{STATUS_BYTES}}; new_code = RC_STATUS; end
+   K_STATE: begin new_len = 8'd{{STATE_BYTES}}; new_code = RC_STATE; end
+   K_CONFIG: begin new_len = 8'd{{CONFIG_BYTES}}; new_code = RC_CONFIG; end
+   default: begin new_len = 8'd{{STATUS_BYTES}}; new_code = RC_TELEMETRY; end   // telemetry
+   endcase
+end
+
+// ---- The reply being written (registered at its start) and its payload (byte 0 in bits 7:0) ---
+reg [KIND_BITS-1:0] kind_q = {KIND_BITS{1'b0}};
+reg [7:0] cmd_q = 8'd0;                          // the command it answers
+reg [7:0] aux_q = 8'd0;                          // the NAK reason or the CONFIG parameter
+reg [1:0] load_q = 2'd0;                         // clocks until the payload is read
 wire [{{ID_TOP}}:0] identity_payload = {{IDENTITY}};
 wire [{{STATE_TOP}}:0] state_payload = {{STATE}};
 wire [{{CONFIG_TOP}}:0] config_payload = {{CONFIG}};
-reg [7:0] new_len;
-reg [7:0] new_code;
 reg [{{PAYLOAD_TOP}}:0] new_payload;
 always @(*) begin
-   case (kind)
-   K_IDENTITY: begin
-      new_len = 8'd{{ID_BYTES}};
-      new_code = RC_IDENTITY;
-      new_payload = {{ID_PADDED}};
-   end
-   K_ACK: begin
-      new_len = 8'd{{ACK_BYTES}};
-      new_code = RC_ACK;
-      new_payload = {{ACK_PADDED}};
-   end
-   K_NAK: begin
-      new_len = 8'd{{NAK_BYTES}};
-      new_code = RC_NAK;
-      new_payload = {{NAK_PADDED}};
-   end
-   K_STATUS: begin
-      new_len = 8'd{{STATUS_BYTES}};
-      new_code = RC_STATUS;
-      new_payload = {{STATUS_PADDED}};
-   end
-   K_STATE: begin
-      new_len = 8'd{{STATE_BYTES}};
-      new_code = RC_STATE;
-      new_payload = {{STATE_PADDED}};
-   end
-   K_CONFIG: begin
-      new_len = 8'd{{CONFIG_BYTES}};
-      new_code = RC_CONFIG;
-      new_payload = {{CONFIG_PADDED}};
-   end
-   default: begin                                // telemetry: the status block
-      new_len = 8'd{{STATUS_BYTES}};
-      new_code = RC_TELEMETRY;
-      new_payload = {{STATUS_PADDED}};
-   end
+   case (kind_q)
+   K_IDENTITY: new_payload = {{ID_PADDED}};
+   K_ACK: new_payload = {{ACK_PADDED}};
+   K_NAK: new_payload = {{NAK_PADDED}};
+   K_STATUS: new_payload = {{STATUS_PADDED}};
+   K_STATE: new_payload = {{STATE_PADDED}};
+   K_CONFIG: new_payload = {{CONFIG_PADDED}};
+   default: new_payload = {{STATUS_PADDED}};     // telemetry: the status block
    endcase
 end
 
@@ -85,7 +78,11 @@ always @(posedge clock) begin
       active_q <= 1'b0;
       index_q <= 8'd0;
       pending_q <= 1'b0;
+      load_q <= 2'd0;
    end else begin
+      // The payload, {{PAYLOAD_DELAY}} clocks after the start (the shift below starts at index 4).
+      if (load_q == 2'd1) payload_q <= new_payload;
+      if (load_q != 2'd0) load_q <= load_q - 2'd1;
       if (!active_q) begin
          if (launch_head || launch_telemetry) begin
             active_q <= 1'b1;
@@ -93,7 +90,10 @@ always @(posedge clock) begin
             len_q <= new_len;
             code_q <= new_code;
             seq_q <= launch_head ? head_seq : 8'd0;
-            payload_q <= new_payload;
+            kind_q <= kind;
+            cmd_q <= head_cmd;
+            aux_q <= head_aux;
+            load_q <= 2'd{{PAYLOAD_DELAY}};
             crc_q <= CRC_INIT;
          end
       end else if (writing) begin
@@ -109,6 +109,7 @@ end
 
 always @(*) begin
    pop = !reset && launch_head;
+   read_param = aux_q;
    fifo_write = writing;
    fifo_data = data;
 end

@@ -1,9 +1,12 @@
 //! The fabric's reply transmitter (`snapgen_hdl::reply_tx::ReplyTx`), clock by clock. When idle
-//! it takes the next queued reply, or else a pending telemetry frame, reads its payload from the
-//! live values at that clock (docs/PROTOCOL.md: a reply reports the device as it is when the
-//! reply starts), and writes the frame — start byte, length, code, sequence, payload, CRC low
-//! then high — into the transmit FIFO one byte per clock while the FIFO is not full. Frames are
-//! never interleaved; telemetry waits while a reply is queued.
+//! it takes the next queued reply, or else a pending telemetry frame, and writes the frame —
+//! start byte, length, code, sequence, payload, CRC low then high — into the transmit FIFO one
+//! byte per clock while the FIFO is not full. Frames are never interleaved; telemetry waits
+//! while a reply is queued. The payload is read from the live values [`PAYLOAD_DELAY`] clocks
+//! after the reply starts (docs/PROTOCOL.md: a reply reports the device as it is when it
+//! starts), a CONFIG reply's value a clock before that (the executor registers the parameter
+//! the reply names): in the fabric the reads are pipelined so that the design closes routed
+//! timing, and the frame's payload bytes come later than that anyway.
 
 use snapgen_spec::fields::{AckPayload, ConfigValue, Identity, NakPayload, StateReply, Status};
 use snapgen_spec::wire::{crc16_step, CRC_INIT, START};
@@ -11,7 +14,8 @@ use snapgen_spec::{code, flag, Param};
 
 use crate::io::executor::{Config, ReplyDesc, ReplyKind};
 
-/// What the payloads are read from (the live values of the clock a reply starts).
+/// What the payloads are read from: the live values of a clock (a reply reads its payload
+/// [`PAYLOAD_DELAY`] clocks after it starts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Live {
     /// The status block.
@@ -66,6 +70,10 @@ impl Live {
     }
 }
 
+/// Clocks from a reply's start to the clock whose live values its payload reads (a CONFIG
+/// reply's value: the clock before).
+pub const PAYLOAD_DELAY: u8 = 2;
+
 /// Inputs of one clock.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ReplyTxInputs {
@@ -101,6 +109,12 @@ pub struct ReplyTx {
     payload: Vec<u8>,
     crc: u16,
     telemetry_pending: bool,
+    /// The reply being written.
+    desc: ReplyDesc,
+    /// Clocks until its payload is read (0: read).
+    load: u8,
+    /// A CONFIG reply's value, read the clock before the payload.
+    config_value: i128,
 }
 
 impl ReplyTx {
@@ -144,6 +158,31 @@ impl ReplyTx {
             *self = ReplyTx::new();
             return out;
         }
+        // The payload of the reply started PAYLOAD_DELAY clocks ago (before this clock's start).
+        match self.load {
+            // The parameter's value, registered by the executor.
+            PAYLOAD_DELAY => {
+                if let (ReplyKind::Config, Some(p)) =
+                    (self.desc.kind, Param::from_byte(self.desc.aux))
+                {
+                    self.config_value = live.config.get(p);
+                }
+                self.load = PAYLOAD_DELAY - 1;
+            }
+            1 => {
+                let (_, mut payload) = live.reply(&self.desc);
+                if self.desc.kind == ReplyKind::Config {
+                    payload = ConfigValue {
+                        param: self.desc.aux,
+                        value: self.config_value,
+                    }
+                    .to_payload();
+                }
+                self.payload = payload;
+                self.load = 0;
+            }
+            _ => {}
+        }
         let mut launched_telemetry = false;
         if !self.active {
             let d = match i.head {
@@ -158,14 +197,17 @@ impl ReplyTx {
                 None => None,
             };
             if let Some(d) = d {
+                // The code and length now; the payload PAYLOAD_DELAY clocks later (its first
+                // byte, frame byte 4, is written 5 clocks after the start at the earliest).
                 let (code, payload) = live.reply(&d);
                 self.active = true;
                 self.index = 0;
                 self.len = payload.len() as u8;
                 self.code = code;
                 self.seq = d.seq;
-                self.payload = payload;
                 self.crc = CRC_INIT;
+                self.desc = d;
+                self.load = PAYLOAD_DELAY;
             }
         } else if out.fifo_write {
             let (k, n) = (self.index, self.len);
