@@ -113,8 +113,6 @@ pub struct ReplyTx {
     desc: ReplyDesc,
     /// Clocks until its payload is read (0: read).
     load: u8,
-    /// A CONFIG reply's value, read the clock before the payload.
-    config_value: i128,
 }
 
 impl ReplyTx {
@@ -159,30 +157,15 @@ impl ReplyTx {
             return out;
         }
         // The payload of the reply started PAYLOAD_DELAY clocks ago (before this clock's start).
+        // A CONFIG reply's payload (its parameter and the value the executor registers) a clock
+        // before every other reply's.
+        let config = self.desc.kind == ReplyKind::Config;
         match self.load {
-            // The parameter's value, registered by the executor.
-            PAYLOAD_DELAY => {
-                if let (ReplyKind::Config, Some(p)) =
-                    (self.desc.kind, Param::from_byte(self.desc.aux))
-                {
-                    self.config_value = live.config.get(p);
-                }
-                self.load = PAYLOAD_DELAY - 1;
-            }
-            1 => {
-                let (_, mut payload) = live.reply(&self.desc);
-                if self.desc.kind == ReplyKind::Config {
-                    payload = ConfigValue {
-                        param: self.desc.aux,
-                        value: self.config_value,
-                    }
-                    .to_payload();
-                }
-                self.payload = payload;
-                self.load = 0;
-            }
+            PAYLOAD_DELAY if config => self.payload = live.reply(&self.desc).1,
+            1 if !config => self.payload = live.reply(&self.desc).1,
             _ => {}
         }
+        self.load = self.load.saturating_sub(1);
         let mut launched_telemetry = false;
         if !self.active {
             let d = match i.head {
