@@ -331,11 +331,13 @@ impl Rtl {
                         let hi = (u128::from(p[1]) << 16) | (u128::from(p[3]) << 48);
                         n.acc = ((self.acc << 16) + lo + hi) & ((1 << 112) - 1);
                     }
-                    // This digit's products (gain digit, most significant first).
+                    // This digit's products (gain digit, most significant first: the gain
+                    // register's top digit, shifted up a digit per product clock).
                     if k < DIGITS {
-                        let g = (self.gain >> (16 * (DIGITS - 1 - k))) & 0xffff;
+                        let g = (self.gain >> (16 * (DIGITS - 1))) & 0xffff;
                         let m = |j: u32| (self.mag >> (16 * j)) & 0xffff;
                         n.prods = [g * m(0), g * m(1), g * m(2), g * m(3)];
+                        n.gain = (self.gain << 16) & ((1 << (16 * DIGITS)) - 1);
                     }
                     // The next term's operand, a clock before it starts.
                     if k == DIGITS {

@@ -59,16 +59,21 @@ reg [7:0] seq_q = 8'd0;
 reg [{{PAYLOAD_TOP}}:0] payload_q = {{PAYLOAD_BITS}}'d0;   // the bytes not yet written, next in 7:0
 reg [15:0] crc_q = 16'd0;
 reg pending_q = 1'b0;                            // a telemetry frame waits
+reg [7:0] end_q = 8'd0;                          // index of the CRC's low byte: len + 4
+// What the byte written next is, registered with its index (so the payload's shift and the
+// CRC's update are enabled by registers and the FIFO's full flag alone): a payload byte, the
+// CRC's low byte, the CRC's high byte (the frame's last).
+reg at_payload_q = 1'b0, at_crc_lo_q = 1'b0, at_last_q = 1'b0;
 wire writing = !reset && active_q && !fifo_full;
-wire [7:0] payload_end = len_q + 8'd4;           // index of the CRC's low byte
+wire [7:0] index_next = index_q + 8'd1;
 reg [7:0] data;
 always @(*) begin
    if (index_q == 8'd0) data = START_BYTE;
    else if (index_q == 8'd1) data = len_q;
    else if (index_q == 8'd2) data = code_q;
    else if (index_q == 8'd3) data = seq_q;
-   else if (index_q < payload_end) data = payload_q[7:0];
-   else if (index_q == payload_end) data = crc_q[7:0];
+   else if (at_payload_q) data = payload_q[7:0];
+   else if (at_crc_lo_q) data = crc_q[7:0];
    else data = crc_q[15:8];
 end
 
@@ -87,7 +92,11 @@ always @(posedge clock) begin
          if (launch_head || launch_telemetry) begin
             active_q <= 1'b1;
             index_q <= 8'd0;
+            at_payload_q <= 1'b0;
+            at_crc_lo_q <= 1'b0;
+            at_last_q <= 1'b0;
             len_q <= new_len;
+            end_q <= new_len + 8'd4;
             code_q <= new_code;
             seq_q <= launch_head ? head_seq : 8'd0;
             kind_q <= kind;
@@ -97,10 +106,14 @@ always @(posedge clock) begin
             crc_q <= CRC_INIT;
          end
       end else if (writing) begin
-         if ((index_q >= 8'd1) && (index_q < payload_end)) crc_q <= crc16_step(crc_q, data);
-         if ((index_q >= 8'd4) && (index_q < payload_end)) payload_q <= payload_q >> 8;
-         index_q <= index_q + 8'd1;
-         if (index_q == payload_end + 8'd1) active_q <= 1'b0;
+         // (The CRC covers bytes 1 to len + 3: every byte but the start and the CRC's own.)
+         if ((index_q != 8'd0) && !at_crc_lo_q && !at_last_q) crc_q <= crc16_step(crc_q, data);
+         if (at_payload_q) payload_q <= payload_q >> 8;
+         index_q <= index_next;
+         at_payload_q <= (index_next >= 8'd4) && (index_next < end_q);
+         at_crc_lo_q <= index_next == end_q;
+         at_last_q <= index_q == end_q;
+         if (at_last_q) active_q <= 1'b0;
       end
       if (launch_telemetry) pending_q <= 1'b0;
       else if (telemetry) pending_q <= 1'b1;

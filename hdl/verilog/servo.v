@@ -29,7 +29,7 @@ reg hold_q = 1'b0;                   // the integrator holds (the output was cla
 reg sat_hi = 1'b0, sat_lo = 1'b0;    // the last output was clamped
 reg [63:0] mag_q = 64'd0;            // the term's operand: magnitude, sign
 reg neg_q = 1'b0;
-reg [47:0] gain_q = 48'd0;           // the term's gain
+reg [47:0] gain_q = 48'd0;           // the term's gain, shifted a digit left per product clock
 reg [111:0] acc_q = 112'd0;          // gain * |operand|, digit by digit
 reg [31:0] p0 = 32'd0, p1 = 32'd0, p2 = 32'd0, p3 = 32'd0;   // a digit's products, registered
 /* verilator lint_off UNUSEDSIGNAL */ // the fraction below bit 47 is what the rounding drops
@@ -98,9 +98,10 @@ end
 reg [63:0] op_q = 64'd0;
 wire [63:0] op_mag = op_q[63] ? (~op_q + 64'd1) : op_q;             // |-2^63| = 2^63 fits
 
-// One gain digit (most significant first) times the magnitude: four 16 x 16 products,
-// registered; added to the accumulator on the next clock.
-wire [15:0] g = (digit == 3'd0) ? gain_q[47:32] : ((digit == 3'd1) ? gain_q[31:16] : gain_q[15:0]);
+// One gain digit (most significant first: the gain register's top 16 bits, which it shifts up
+// a digit per product clock, so the multipliers read a register) times the magnitude: four
+// 16 x 16 products, registered; added to the accumulator on the next clock.
+wire [15:0] g = gain_q[47:32];
 // acc = (acc << 16) + {p2, p0} + {p3, p1} << 16: three operands, added carry-save (their
 // bitwise sum and carries, then one carry chain).
 wire [111:0] acc_x = {acc_q[95:0], 16'd0};
@@ -113,8 +114,16 @@ wire [111:0] acc_next = (acc_x ^ acc_y ^ acc_z) + {acc_carries, 1'b0};
 // Finish: round to nearest (halves up): the sum starts at 2^{{HALF}}, so u = sum >>> {{OUT_SHIFT}};
 // saturate.
 wire [67:0] u = sum_q[115:48];
-wire u_hi = $signed(u) > $signed({52'd0, olim_q});
-wire u_lo = $signed(u) < $signed({{51{olim_neg_q[16]}}, olim_neg_q});
+// u > OUTPUT_LIMIT and u < −OUTPUT_LIMIT, split at bit 16 so that no 68-bit carry chain
+// precedes the output's multiplexer: the high 52 bits all 0 or all 1 (wide ANDs), beside a
+// 16-bit compare of the low bits. (−OUTPUT_LIMIT, 17 bits: its high bits are all 1 when it is
+// below 0, all 0 when it is 0.)
+wire u_top_zero = u[67:16] == 52'd0;
+wire u_top_ones = u[67:16] == {52{1'b1}};
+wire u_hi = (!u[67] && !u_top_zero) || (u_top_zero && (u[15:0] > olim_q));
+wire u_lo = olim_neg_q[16]
+   ? ((u[67] && !u_top_ones) || (u_top_ones && (u[15:0] < olim_neg_q[15:0])))
+   : u[67];
 
 always @(posedge clock) begin
    fault_q <= 1'b0;
@@ -210,6 +219,7 @@ always @(posedge clock) begin
                   p1 <= g * mag_q[31:16];
                   p2 <= g * mag_q[47:32];
                   p3 <= g * mag_q[63:48];
+                  gain_q <= {gain_q[31:0], 16'd0};
                end
                digit <= digit + 3'd1;
             end else begin
