@@ -82,12 +82,86 @@ reg [WATCHDOG_MS_BITS-1:0] watchdog_count_q = {WATCHDOG_MS_BITS{1'b0}}, n_watchd
 reg [TELEMETRY_PERIOD_BITS-1:0] telemetry_left_q = {TELEMETRY_PERIOD_BITS{1'b0}}, n_telemetry_left;
 reg was_driven_q = 1'b0, n_was_driven;
 
+// ---- The inputs, registered where they arrive ---------------------------------------------------
+// Every decision reads the inputs of the clock before (the model's `registered`), so no path
+// runs from another block (the core's status, the reply queue, the switches) through a
+// decision in one clock; the frame's code, sequence and CRC are among them. Two reads stay
+// live: the frame's length and payload (complete and unchanged for hundreds of clocks around
+// the frame's strobe; what the decision needs of them is decoded a clock ahead, pre_* below)
+// and the time base (SWAP_AT's lead, below, is registered on every clock). 0 after a reset.
+reg in_frame = 1'b0, in_bad_crc = 1'b0, in_dropped = 1'b0;
+reg [7:0] in_cmd = 8'd0, in_seq = 8'd0;
+reg [15:0] in_crc = 16'd0;
+reg in_line_error = 1'b0, in_servo_overrun_in = 1'b0, in_queue_full = 1'b0;
+reg in_busy = 1'b0, in_stopping = 1'b0, in_at_rest = 1'b0, in_swap_pending = 1'b0;
+reg in_standby_empty = 1'b1;                     // the standby program's count is 0
+reg in_heading_pos = 1'b0, in_heading_neg = 1'b0, in_tick = 1'b0;
+reg in_limit_pos = 1'b0, in_limit_neg = 1'b0, in_estop = 1'b0, in_following_fault = 1'b0;
+reg [15:0] in_encoder_errors = 16'd0;
+always @(posedge clock) begin
+   if (reset) begin
+      in_frame <= 1'b0;
+      in_cmd <= 8'd0;
+      in_seq <= 8'd0;
+      in_crc <= 16'd0;
+      in_bad_crc <= 1'b0;
+      in_dropped <= 1'b0;
+      in_line_error <= 1'b0;
+      in_servo_overrun_in <= 1'b0;
+      in_queue_full <= 1'b0;
+      in_busy <= 1'b0;
+      in_stopping <= 1'b0;
+      in_at_rest <= 1'b0;
+      in_swap_pending <= 1'b0;
+      in_standby_empty <= 1'b1;
+      in_heading_pos <= 1'b0;
+      in_heading_neg <= 1'b0;
+      in_tick <= 1'b0;
+      in_limit_pos <= 1'b0;
+      in_limit_neg <= 1'b0;
+      in_estop <= 1'b0;
+      in_following_fault <= 1'b0;
+      in_encoder_errors <= 16'd0;
+   end else begin
+      in_frame <= frame;
+      in_cmd <= cmd;
+      in_seq <= seq;
+      in_crc <= crc;
+      in_bad_crc <= bad_crc;
+      in_dropped <= dropped;
+      in_line_error <= line_error;
+      in_servo_overrun_in <= servo_overrun_in;
+      in_queue_full <= queue_full;
+      in_busy <= busy;
+      in_stopping <= stopping;
+      in_at_rest <= at_rest;
+      in_swap_pending <= swap_pending;
+      in_standby_empty <= standby_count == {INDEX_BITS{1'b0}};
+      in_heading_pos <= heading_pos;
+      in_heading_neg <= heading_neg;
+      in_tick <= tick;
+      in_limit_pos <= limit_pos;
+      in_limit_neg <= limit_neg;
+      in_estop <= estop;
+      in_following_fault <= following_fault;
+      in_encoder_errors <= encoder_errors;
+   end
+end
+// The start, stop and swap pulses sent two clocks ago (the status read now, registered twice,
+// does not show them yet).
+reg start_q2 = 1'b0, stop_q2 = 1'b0, swap_q2 = 1'b0;
+always @(posedge clock) begin
+   start_q2 <= !reset && start_q;
+   stop_q2 <= !reset && stop_q;
+   swap_q2 <= !reset && swap_q;
+end
+
 // ---- Arguments and axis state: why the command is refused (0: accepted) ----------------------
 // The chain is at rest: the core's at_rest is a register, one clock old, so on the clock after
 // the chain was driven (its last tick may have moved it) it does not count.
-wire rested = at_rest && !was_driven_q;
+wire rested = in_at_rest && !was_driven_q;
 // The axis moves: a program plays, a stop runs, or v, a or j is not 0.
-wire moving = busy || stopping || !rested;
+wire moving = in_busy || in_stopping || !rested;
 wire stop_limits_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= stop_accel_q);
 // With the controller on, POWER 1 wants a following-error limit.
 wire servo_ready = (servo_period_q == {SERVO_PERIOD_BITS{1'b0}})
@@ -162,7 +236,7 @@ always @(posedge clock) begin
       && (swap_lead[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
 end
 wire [SWAP_BITS-1:0] swap_before = swap_tick[SWAP_BITS-1:0] - 1'b1;   // the core's swap_last: T − 1
-wire toward_limit = (first_pos_q && limit_pos) || (first_neg_q && limit_neg);
+wire toward_limit = (first_pos_q && in_limit_pos) || (first_neg_q && in_limit_neg);
 // ErrorStop with the amplifier off and the axis at rest: nothing can move, as while Disabled,
 // so the parameters settable only while Disabled may be set (INPUT_POLARITY set back).
 wire inert = (state_q == S_ERROR_STOP) && !amplifier_q && !moving;
@@ -177,18 +251,18 @@ begin
    case (c)
       CMD_LOAD_SEGMENT:
          if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
-         else if (swap_pending) refusal = R_SWAP_PENDING;
+         else if (in_swap_pending) refusal = R_SWAP_PENDING;
       CMD_COMMIT:
          if (pre_bad_argument) refusal = R_BAD_ARGUMENT;
-         else if (swap_pending) refusal = R_SWAP_PENDING;
+         else if (in_swap_pending) refusal = R_SWAP_PENDING;
       CMD_START:
          if (st == S_DISABLED) refusal = R_NOT_ENABLED;
          else if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
          else if (st == S_STOPPING) refusal = R_STOPPING;
-         else if (busy) refusal = R_BUSY;
-         else if (stopping) refusal = R_STOPPING;
-         else if (swap_pending) refusal = R_SWAP_PENDING;
-         else if (standby_count == {INDEX_BITS{1'b0}}) refusal = R_NO_PROGRAM;
+         else if (in_busy) refusal = R_BUSY;
+         else if (in_stopping) refusal = R_STOPPING;
+         else if (in_swap_pending) refusal = R_SWAP_PENDING;
+         else if (in_standby_empty) refusal = R_NO_PROGRAM;
          else if (!rested) refusal = R_BUSY;
          else if (toward_limit) refusal = R_LIMIT;
       CMD_SWAP_AT:
@@ -196,11 +270,11 @@ begin
          else if (st == S_DISABLED) refusal = R_NOT_ENABLED;
          else if (st == S_ERROR_STOP) refusal = R_AXIS_ERROR;
          else if (st == S_STOPPING) refusal = R_STOPPING;
-         else if (stopping) refusal = R_STOPPING;
-         else if (swap_pending) refusal = R_SWAP_PENDING;
-         else if (standby_count == {INDEX_BITS{1'b0}}) refusal = R_NO_PROGRAM;
+         else if (in_stopping) refusal = R_STOPPING;
+         else if (in_swap_pending) refusal = R_SWAP_PENDING;
+         else if (in_standby_empty) refusal = R_NO_PROGRAM;
          else if (swap_late_q) refusal = R_LATE;
-         else if (rested && !busy && toward_limit) refusal = R_LIMIT;
+         else if (rested && !in_busy && toward_limit) refusal = R_LIMIT;
       CMD_STOP:
          if (st == S_DISABLED) refusal = R_NOT_ENABLED;
       CMD_HALT:
@@ -222,26 +296,35 @@ begin
                refusal = R_NOT_CONFIGURED;
          end else if (moving) refusal = R_BUSY;
       CMD_RESET:
-         if ((st == S_ERROR_STOP) && (moving || estop)) refusal = R_AXIS_ERROR;
+         if ((st == S_ERROR_STOP) && (moving || in_estop)) refusal = R_AXIS_ERROR;
    default: ;
    endcase
 end
 endfunction
-wire [7:0] reason = refusal(cmd, state_q);
+wire [7:0] reason = refusal(in_cmd, state_q);
 
-wire retry = pre_has_effect && last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q)
-   && (crc == last_crc_q);
+// A retry: the frame's code, sequence and CRC are the last command's. Compared on every clock
+// from the frame's fields as they stand (the CRC's on the frame's own clock) and registered:
+// the last command changes only when a frame is executed.
+reg pre_retry = 1'b0;
+always @(posedge clock)
+   pre_retry <= last_valid_q && (cmd == last_cmd_q) && (seq == last_seq_q) && (crc == last_crc_q);
+wire retry = pre_has_effect && pre_retry;
 // The frame is executed: good, answered, of its length, not a retry ...
-wire executes = frame && !bad_crc && !dropped && !queue_full && pre_len_ok && !retry;
+wire executes = in_frame && !in_bad_crc && !in_dropped && !in_queue_full && pre_len_ok && !retry;
 // ... and is command c, not refused in axis state st: c's effect applies.
 function automatic taken(input [7:0] c, input [STATE_BITS-1:0] st);
-   taken = executes && (cmd == c) && (refusal(c, st) == 8'd0);
+   taken = executes && (in_cmd == c) && (refusal(c, st) == 8'd0);
 endfunction
-wire expired = (watchdog_ms_q != {WATCHDOG_MS_BITS{1'b0}}) && (watchdog_count_q >= watchdog_ms_q);
-// A start, stop or swap the core takes now, or the chain driven on the last clock (the core's
-// at_rest is a register: it tells where the last tick left the chain a clock later).
-wire settling = start_q || stop_q || swap_q || was_driven_q;
-wire driven = busy || stopping;
+// The watchdog expired (registered: the count compared on the clock before decides).
+reg expired = 1'b0;
+always @(posedge clock)
+   expired <= !reset && (watchdog_ms_q != {WATCHDOG_MS_BITS{1'b0}}) && (watchdog_count_q >= watchdog_ms_q);
+// A start, stop or swap sent on either of the last two clocks (the status read now, registered
+// in the core and again here, does not show it yet), or the chain driven on the last clock (the
+// core's at_rest is a register: it tells where the last tick left the chain a clock later).
+wire settling = start_q || stop_q || swap_q || start_q2 || stop_q2 || swap_q2 || was_driven_q;
+wire driven = in_busy || in_stopping;
 
 // ---- Next state, in the model's order ------------------------------------------------------
 always @(*) begin
@@ -287,7 +370,7 @@ always @(*) begin
    // Telemetry while the chain is driven, and once when it stops being driven, from the period
    // and countdown before this clock (a CONFIGURE of the period, below, restarts the countdown).
    if (telemetry_period_q != {TELEMETRY_PERIOD_BITS{1'b0}}) begin
-      if (tick && driven) begin
+      if (in_tick && driven) begin
          if (telemetry_left_q <= {{(TELEMETRY_PERIOD_BITS-1){1'b0}}, 1'b1}) begin
             n_telemetry = 1'b1;
             n_telemetry_left = telemetry_period_q;
@@ -303,7 +386,7 @@ always @(*) begin
    // The watchdog: milliseconds since the last good frame (saturating).
    n_prescale = prescale_q + 32'd1;
    n_watchdog_count = watchdog_count_q;
-   if (frame) begin
+   if (in_frame) begin
       n_prescale = 32'd0;
       n_watchdog_count = {WATCHDOG_MS_BITS{1'b0}};
    end else if (prescale_q + 32'd1 >= CLOCKS_PER_MS) begin
@@ -312,11 +395,11 @@ always @(*) begin
    end
 
    // Frames.
-   if (line_error) n_uart_error = 1'b1;
-   if (servo_overrun_in) n_servo_overrun = 1'b1;
-   if (bad_crc) begin
+   if (in_line_error) n_uart_error = 1'b1;
+   if (in_servo_overrun_in) n_servo_overrun = 1'b1;
+   if (in_bad_crc) begin
       n_bad_crc = bad_crc_q + 16'd1;
-      if (queue_full) n_overflow = 1'b1;
+      if (in_queue_full) n_overflow = 1'b1;
       else begin
          n_reply = 1'b1;
          n_reply_kind = K_NAK;
@@ -324,9 +407,9 @@ always @(*) begin
          n_reply_seq = 8'd0;
          n_reply_aux = R_BAD_CRC;
       end
-   end else if (dropped) begin
+   end else if (in_dropped) begin
       n_bad_frames = bad_frames_q + 16'd1;
-      if (queue_full) n_overflow = 1'b1;
+      if (in_queue_full) n_overflow = 1'b1;
       else begin
          n_reply = 1'b1;
          n_reply_kind = K_NAK;
@@ -334,10 +417,10 @@ always @(*) begin
          n_reply_seq = 8'd0;
          n_reply_aux = R_FRAMING;
       end
-   end else if (frame) begin
-      n_reply_cmd = cmd;
-      n_reply_seq = seq;
-      if (queue_full) n_overflow = 1'b1;
+   end else if (in_frame) begin
+      n_reply_cmd = in_cmd;
+      n_reply_seq = in_seq;
+      if (in_queue_full) n_overflow = 1'b1;
       else if (!pre_len_ok) begin
          n_bad_frames = bad_frames_q + 16'd1;
          n_reply = 1'b1;
@@ -350,14 +433,14 @@ always @(*) begin
          n_reply_aux = last_aux_q;
       end else begin
          // PING: a new host session; no command before it is retried.
-         if (cmd == CMD_PING) n_last_valid = 1'b0;
+         if (in_cmd == CMD_PING) n_last_valid = 1'b0;
          n_reply = 1'b1;
          n_reply_kind = K_ACK;
          n_reply_aux = 8'd0;
          if (reason != 8'd0) begin
             n_reply_kind = K_NAK;
             n_reply_aux = reason;
-         end else case (cmd)
+         end else case (in_cmd)
          CMD_PING: n_reply_kind = K_IDENTITY;
          CMD_READ_STATUS: n_reply_kind = K_STATUS;
          CMD_READ_STATE: n_reply_kind = K_STATE;
@@ -369,9 +452,9 @@ always @(*) begin
          endcase
          if (pre_has_effect) begin
             n_last_valid = 1'b1;
-            n_last_cmd = cmd;
-            n_last_seq = seq;
-            n_last_crc = crc;
+            n_last_cmd = in_cmd;
+            n_last_seq = in_seq;
+            n_last_crc = in_crc;
             n_last_kind = n_reply_kind;
             n_last_aux = n_reply_aux;
          end
@@ -437,7 +520,7 @@ always @(*) begin
       n_uart_error = 1'b0;
       n_overflow = 1'b0;
       n_servo_overrun = 1'b0;
-      n_enc_seen = encoder_errors;
+      n_enc_seen = in_encoder_errors;
       if (state_q == S_ERROR_STOP) begin
          n_error = E_NONE;
          n_state = amplifier_q ? S_STANDSTILL : S_DISABLED;
@@ -446,11 +529,12 @@ always @(*) begin
 
    // The axis by itself: the end of a move or a stop (at rest: Standstill; a program that ended
    // moving: a controlled stop into ErrorStop), then the errors (the emergency stop last: it
-   // overrides everything).
-   if (((n_state == S_DISCRETE_MOTION) || (n_state == S_CONTINUOUS_MOTION) || (n_state == S_STOPPING))
-         && (state_q == n_state) && !busy && !stopping && !settling
-         && !(at_rest && swap_pending)) begin   // a swap armed at rest: a start to come
-      if (at_rest) n_state = S_STANDSTILL;
+   // overrides everything). Not on a clock a frame is executed (a clock later: the end of a
+   // move does not wait on the command's decision).
+   if (((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION) || (state_q == S_STOPPING))
+         && !executes && !in_busy && !in_stopping && !settling
+         && !(in_at_rest && in_swap_pending)) begin   // a swap armed at rest: a start to come
+      if (in_at_rest) n_state = S_STANDSTILL;
       else begin
          n_stop = 1'b1;
          n_state = S_ERROR_STOP;
@@ -463,17 +547,17 @@ always @(*) begin
       n_error = E_WATCHDOG;
    end
    if ((state_q != S_ERROR_STOP) && (state_q != S_DISABLED)) begin
-      if (limit_pos && heading_pos) begin
+      if (in_limit_pos && in_heading_pos) begin
          n_stop = 1'b1;
          n_state = S_ERROR_STOP;
          n_error = E_LIMIT_POSITIVE;
-      end else if (limit_neg && heading_neg) begin
+      end else if (in_limit_neg && in_heading_neg) begin
          n_stop = 1'b1;
          n_state = S_ERROR_STOP;
          n_error = E_LIMIT_NEGATIVE;
       end
    end
-   if (following_fault && n_amplifier) begin
+   if (in_following_fault && amplifier_q) begin
       n_abort = 1'b1;
       n_stop = 1'b0;
       n_start = 1'b0;
@@ -482,7 +566,7 @@ always @(*) begin
       n_state = S_ERROR_STOP;
       n_error = E_FOLLOWING_ERROR;
    end
-   if (estop && !((state_q == S_ERROR_STOP) && (error_q == E_EMERGENCY_STOP))) begin
+   if (in_estop && !((state_q == S_ERROR_STOP) && (error_q == E_EMERGENCY_STOP))) begin
       n_abort = 1'b1;
       n_stop = 1'b0;
       n_start = 1'b0;
@@ -492,8 +576,9 @@ always @(*) begin
       n_error = E_EMERGENCY_STOP;
    end
    // A stop or an abort cancels an armed swap, and its program, planned for the swap's tick,
-   // never plays from another state: the standby bank is emptied.
-   if ((n_stop || n_abort) && swap_pending) begin
+   // never plays from another state: the standby bank is emptied (a swap sent on either of the
+   // last two clocks counts: the status does not show it yet).
+   if ((n_stop || n_abort) && (in_swap_pending || swap_q || swap_q2)) begin
       n_count_enable = 1'b1;
       n_count_value = {INDEX_BITS{1'b0}};
    end

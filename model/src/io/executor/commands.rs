@@ -20,30 +20,31 @@ impl Executor {
         }
     }
 
-    /// A frame with a good CRC.
-    pub(super) fn command(&mut self, i: &ExecutorInputs, s: AxisState, cfg: Config) {
+    /// A frame with a good CRC. True when it is executed: answered, of its command's length
+    /// and not a retry (whether refused or not).
+    pub(super) fn command(&mut self, i: &ExecutorInputs, s: AxisState, cfg: Config) -> bool {
         let rx = &i.rx;
         let (c, seq) = (rx.cmd, rx.seq);
         if i.queue_full {
             self.out.reply_overflow = true;
-            return;
+            return false;
         }
         let Some(spec) = command_spec(c) else {
             self.out.bad_frames = self.out.bad_frames.wrapping_add(1);
             self.out.reply = Some(nak(c, seq, Reason::UnknownCommand));
-            return;
+            return false;
         };
         if rx.len != spec.len {
             self.out.bad_frames = self.out.bad_frames.wrapping_add(1);
             self.out.reply = Some(nak(c, seq, Reason::BadLength));
-            return;
+            return false;
         }
         if spec.effect {
             if let Some((lc, ls, lcrc, reply)) = self.last {
                 if (lc, ls, lcrc) == (c, seq, rx.crc) {
                     // A retry: the same answer, no effect.
                     self.out.reply = Some(reply);
-                    return;
+                    return false;
                 }
             }
         }
@@ -74,6 +75,7 @@ impl Executor {
         if spec.effect {
             self.last = Some((c, seq, rx.crc, reply));
         }
+        true
     }
 
     /// Arguments and axis state: why the command is refused, if it is.
@@ -260,7 +262,8 @@ mod tests {
     use crate::io::frame_rx::FrameRxOutputs;
 
     /// The reply to POWER 0 on a clock with the chain at rest by the core's (registered)
-    /// `at_rest`, busy and stopping low, after a clock with the chain driven or not.
+    /// `at_rest`, busy and stopping low, after a clock with the chain driven or not (each
+    /// read by the executor a clock after it is presented: its inputs are registered).
     fn power_off_reply(driven_before: bool) -> Option<ReplyDesc> {
         let mut e = Executor::new(0, 1000, 0);
         e.clock(&ExecutorInputs {
@@ -279,6 +282,8 @@ mod tests {
             len: 1,
             ..Default::default()
         };
+        e.clock(&i);
+        i.rx.frame = false;
         e.clock(&i).reply
     }
 

@@ -1,6 +1,12 @@
 //! The fabric's command executor and axis state machine (`snapgen_hdl::executor::Executor`),
 //! clock by clock. Every output is registered: what it decides on clock `c` takes effect on
-//! clock `c + 1`.
+//! clock `c + 1`. Its inputs are registered too, where they arrive: it decides on clock `c`
+//! from the inputs of clock `c − 1` (the frame's strobes, the core's status, the reply queue,
+//! the switches and faults, the frame's code, sequence and CRC), so no path runs from another
+//! block through a decision in one clock. Two reads are live: the frame's length and payload
+//! (complete and unchanged for hundreds of clocks around its strobe; what the decision needs
+//! of them is decoded a clock ahead in the fabric) and the time base, of which SWAP_AT's lead
+//! is registered on every clock as before.
 //!
 //! On each frame with a good CRC it checks the command (docs/PROTOCOL.md: code, length,
 //! arguments, then the axis state), applies its effect (a segment write, a count, a start, a
@@ -93,7 +99,8 @@ pub struct ReplyDesc {
     pub aux: u8,
 }
 
-/// Inputs of one clock (every one a registered output of another block).
+/// Inputs of one clock (every one a registered output of another block; the executor registers
+/// them again before it reads them).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ExecutorInputs {
     /// Synchronous reset.
@@ -171,9 +178,16 @@ pub struct Executor {
     /// The sign of the standby program's first snap (segment 0): +1, −1 or 0.
     first_direction: i8,
     /// A SWAP_AT's tick less the time base, registered every clock from the received
-    /// payload (taken as an 8-byte one): one clock old when the frame is executed, so no
-    /// 64-bit subtraction lies in the command's decision path.
+    /// payload (taken as an 8-byte one) and the live time base: one clock old when the frame
+    /// is executed, so no 64-bit subtraction lies in the command's decision path.
     swap_lead: u64,
+    /// The watchdog had expired on the last clock.
+    expired: bool,
+    /// The inputs of the last clock, registered (0 after a reset).
+    registered: ExecutorInputs,
+    /// The start, stop and swap pulses sent two clocks ago: the core's status read on this
+    /// clock (registered twice, once in the core and once here) does not show them yet.
+    older_pulses: [bool; 3],
 }
 
 impl Executor {
@@ -194,8 +208,39 @@ impl Executor {
     }
 
     /// One clock.
-    pub fn clock(&mut self, i: &ExecutorInputs) -> ExecutorOutputs {
+    pub fn clock(&mut self, live: &ExecutorInputs) -> ExecutorOutputs {
+        // What this clock reads: the inputs registered on the last clock, with the frame's
+        // length and payload as they stand (its strobes, code, sequence and CRC registered).
+        let registered = std::mem::replace(
+            &mut self.registered,
+            if live.reset {
+                ExecutorInputs::default()
+            } else {
+                *live
+            },
+        );
+        let i = &ExecutorInputs {
+            reset: live.reset,
+            rx: crate::io::frame_rx::FrameRxOutputs {
+                len: live.rx.len,
+                payload: live.rx.payload,
+                ..registered.rx
+            },
+            ..registered
+        };
         let before = self.out;
+        let older = std::mem::replace(
+            &mut self.older_pulses,
+            if live.reset {
+                [false; 3]
+            } else {
+                [
+                    before.command.start,
+                    before.command.stop,
+                    before.command.swap,
+                ]
+            },
+        );
         // Pulses last one clock; the values they carry are held (the core reads them with
         // their pulse only).
         let c = &mut self.out.command;
@@ -220,6 +265,7 @@ impl Executor {
             self.was_driven = false;
             self.first_direction = 0;
             self.swap_lead = 0;
+            self.expired = false;
             return self.out;
         }
         let s = before.state;
@@ -247,7 +293,11 @@ impl Executor {
         }
 
         // The watchdog: milliseconds since the last good frame.
-        let expired = cfg.watchdog_ms != 0 && self.watchdog_count >= cfg.watchdog_ms;
+        // (Registered: the count compared on the clock before decides on this one.)
+        let expired = std::mem::replace(
+            &mut self.expired,
+            cfg.watchdog_ms != 0 && self.watchdog_count >= cfg.watchdog_ms,
+        );
         if i.rx.frame {
             self.prescale = 0;
             self.watchdog_count = 0;
@@ -272,23 +322,28 @@ impl Executor {
         } else if i.rx.dropped {
             o.bad_frames = o.bad_frames.wrapping_add(1);
             self.queue(i, nak(0, 0, Reason::Framing));
-        } else if i.rx.frame {
-            self.command(i, s, cfg);
         }
+        let executed = !i.rx.bad_crc && !i.rx.dropped && i.rx.frame && self.command(i, s, cfg);
         let o = &mut self.out;
 
         // The axis by itself: the end of a move or a stop (at rest: Standstill; a program that
         // ended moving: a controlled stop into ErrorStop), then the errors (the emergency stop
-        // last: it overrides everything).
+        // last: it overrides everything). Not on a clock a frame is executed (a clock later:
+        // the end of a move does not wait on the command's decision).
         // (A swap armed while the axis rests is a start still to come.)
-        // The core's `at_rest` is a register: a clock after the chain stopped being driven it
+        // The status read here is two clocks old (the core's registers, then the executor's):
+        // a start, stop or swap sent on either of the last two clocks does not show in it yet;
+        // the core's `at_rest` is a register: a clock after the chain stopped being driven it
         // tells where the last tick left the chain.
-        let settling =
-            before.command.start || before.command.stop || before.command.swap || was_driven;
+        let settling = before.command.start
+            || before.command.stop
+            || before.command.swap
+            || older.iter().any(|&p| p)
+            || was_driven;
         if matches!(
-            o.state,
+            s,
             AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::Stopping
-        ) && s == o.state
+        ) && !executed
             && !i.core.busy
             && !i.core.stopping
             && !settling
@@ -321,20 +376,25 @@ impl Executor {
                 o.error = e;
             }
         }
-        if i.following_fault && o.amplifier {
+        // (The amplifier before this clock's command: a fault on the clock POWER 0 is taken
+        // still counts.)
+        if i.following_fault && before.amplifier {
             disable_at_once(o, ErrorId::FollowingError);
         }
         if i.estop && !(s == AxisState::ErrorStop && before.error == ErrorId::EmergencyStop) {
             disable_at_once(o, ErrorId::EmergencyStop);
         }
         // A stop or an abort cancels an armed swap, and its program, planned for the swap's
-        // tick, never plays from another state: the standby bank is emptied.
-        if (o.command.stop || o.command.abort_move) && i.core.swap_pending {
+        // tick, never plays from another state: the standby bank is emptied (a swap sent on
+        // either of the last two clocks counts: the status does not show it yet).
+        if (o.command.stop || o.command.abort_move)
+            && (i.core.swap_pending || before.command.swap || older[2])
+        {
             o.command.count_enable = true;
             o.command.count_value = 0;
         }
 
-        self.swap_lead = swap_tick_field(&i.rx).wrapping_sub(i.core.ticks);
+        self.swap_lead = swap_tick_field(&live.rx).wrapping_sub(live.core.ticks);
         // (Registered last: the commands above read the value before this clock.)
         self.was_driven = driven;
         self.out
