@@ -179,8 +179,8 @@ wire cfg_pair_valid = (cfg_param == P_STOP_JERK) ? jerk_pair_valid
 // and the registers they are checked against (the parameters) change only when a frame is
 // executed (more than a clock before the next one is) or by a reset (which the frame receiver
 // shares): what depends on them alone is registered on every clock and is exact on the
-// frame's clock (the state, the core's outputs and the received CRC are read on that clock
-// itself).
+// frame's clock (the state is read on that clock itself; the core's outputs a clock earlier,
+// through in_*, and the received CRC on the frame receiver's own clock, through pre_retry).
 reg pre_known = 1'b0;                            // the command is in the table
 reg pre_len_ok = 1'b0;                           // ... and has its payload length
 reg pre_has_effect = 1'b0;
