@@ -155,14 +155,14 @@ snapgen_spec::with_motion_core_ports!(executor_block! {
             following_fault: Bit,
             /// The controller skipped a sample.
             servo_overrun_in: Bit,
-            /// The parameter whose value `read_value` gives a clock later (the reply
-            /// transmitter's CONFIG reply).
+            /// The parameter the reply transmitter's CONFIG reply names after this edge
+            /// (combinational); `read_value` gives its value two clocks later.
             read_param: Bits<8>,
         }
         outputs {
-            /// TELEMETRY_PERIOD and WATCHDOG_MS are the executor's own; the value of
-            /// parameter `read_param` named on the clock before (registered; 0 for an unknown
-            /// one).
+            /// TELEMETRY_PERIOD and WATCHDOG_MS are the executor's own; the value, on the
+            /// clock before, of the parameter `read_param` named on the clock before that
+            /// (registered twice: the parameter one-hot, then the value; 0 for an unknown one).
             read_value: Bits<D_BITS>,
             /// The axis state (the status block's byte).
             state: Bits<8>,
@@ -345,8 +345,13 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         String::new(),
         String::new(),
     );
-    let (mut resets, mut clocked, mut outs, mut read) =
-        (String::new(), String::new(), String::new(), String::new());
+    let (mut resets, mut clocked, mut outs, mut read, mut read_select) = (
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+        String::new(),
+    );
     for (k, p) in PARAMS.iter().enumerate() {
         let (name, bits) = (p.register, p.bits);
         let pn = format!("P_{}", p.name);
@@ -367,8 +372,9 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         };
         resets.push_str(&format!("{name}_q <= {bits}'d{};\n", p.reset_value(design)));
         clocked.push_str(&format!("{name}_q <= n_{name};\n"));
+        read_select.push_str(&format!("{pn}: read_sel_q[{k}] <= 1'b1;\n"));
         read.push_str(&format!(
-            "{pn}: read_value_q <= {};\n",
+            "| ({{D_BITS{{read_sel_q[{k}]}}}} & {})\n",
             if bits as usize == D_BITS {
                 format!("{name}_q")
             } else {
@@ -392,6 +398,7 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         .block("param_resets", resets)
         .block("param_clocked", clocked)
         .block("param_outputs", outs)
+        .block("param_read_select", read_select)
         .block("param_read", read);
     let body = fill("executor.v", TEMPLATE, &holes).expect("the executor's template is filled");
     let mut params = protocol_v::localparams();

@@ -73,8 +73,8 @@ pub struct ReplyTx {
     pub stop_jerk: Signal<In, Bits<D_BITS>>,
     /// STOP_ACCEL.
     pub stop_accel: Signal<In, Bits<D_BITS>>,
-    /// The value of the parameter `read_param` named on the clock before (the executor's
-    /// registered `read_value`): a CONFIG reply's value.
+    /// The value of the parameter this block's CONFIG reply names (the executor's
+    /// registered `read_value`, from `read_param` two clocks before): a CONFIG reply's value.
     pub config_value: Signal<In, Bits<D_BITS>>,
     /// Ticks since reset.
     pub ticks: Signal<In, Bits<64>>,
@@ -88,7 +88,8 @@ pub struct ReplyTx {
     pub j: Signal<In, Bits<D_BITS>>,
     /// Take the queue's head now (combinational).
     pub pop: Signal<Out, Bit>,
-    /// The parameter a CONFIG reply being written reads (registered at its start).
+    /// The parameter a CONFIG reply reads, as it is after this edge (combinational: the
+    /// executor registers it decoded as this block registers it at the reply's start).
     pub read_param: Signal<Out, Bits<8>>,
     /// Write `fifo_data` now (combinational).
     pub fifo_write: Signal<Out, Bit>,

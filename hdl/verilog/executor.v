@@ -57,6 +57,7 @@ reg [TICK_BITS-1:0] write_ticks_q = {TICK_BITS{1'b0}}, n_write_ticks;
 reg [D_BITS-1:0] write_snap_q = {D_BITS{1'b0}}, n_write_snap;
 reg count_enable_q = 1'b0, n_count_enable;
 reg [INDEX_BITS-1:0] count_value_q = {INDEX_BITS{1'b0}}, n_count_value;
+reg empty_standby_q = 1'b0, n_empty_standby;   // empty the standby bank on the next clock
 reg start_q = 1'b0, n_start;
 reg swap_q = 1'b0, n_swap;
 reg [SWAP_BITS-1:0] swap_last_q = {SWAP_BITS{1'b0}}, n_swap_last;
@@ -168,18 +169,37 @@ wire servo_ready = (servo_period_q == {SERVO_PERIOD_BITS{1'b0}})
    || (following_limit_q != {FOLLOWING_LIMIT_BITS{1'b0}});
 // The stop limits a CONFIGURE would leave valid (0 < jerk <= accel): each parameter's case
 // compares the new value with the other register (two comparators side by side, off the
-// parameter's multiplexer).
-wire jerk_pair_valid = (cfg_value != {D_BITS{1'b0}}) && (cfg_value <= stop_accel_q);
-wire accel_pair_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= cfg_value);
-wire cfg_pair_valid = (cfg_param == P_STOP_JERK) ? jerk_pair_valid
-   : ((cfg_param == P_STOP_ACCEL) ? accel_pair_valid : 1'b1);
+// parameter's multiplexer), in two clocks: each D_BITS-bit compare split in halves whose
+// results are registered (less, equal above; less or equal below), then combined into
+// pre_cfg_pair_bad below, two clocks after the payload and the registers (stable for longer:
+// see the decode a clock ahead).
+localparam HALF = D_BITS / 2;
+reg jerk_hi_lt = 1'b0, jerk_hi_eq = 1'b0, jerk_lo_le = 1'b0, jerk_nonzero = 1'b0;
+reg accel_hi_lt = 1'b0, accel_hi_eq = 1'b0, accel_lo_le = 1'b0, accel_nonzero = 1'b0;
+reg cfg_is_jerk = 1'b0, cfg_is_accel = 1'b0;
+always @(posedge clock) begin
+   // CONFIGURE STOP_JERK: 0 < value <= STOP_ACCEL.
+   jerk_hi_lt <= cfg_value[D_BITS-1:HALF] < stop_accel_q[D_BITS-1:HALF];
+   jerk_hi_eq <= cfg_value[D_BITS-1:HALF] == stop_accel_q[D_BITS-1:HALF];
+   jerk_lo_le <= cfg_value[HALF-1:0] <= stop_accel_q[HALF-1:0];
+   jerk_nonzero <= cfg_value != {D_BITS{1'b0}};
+   // CONFIGURE STOP_ACCEL: 0 < STOP_JERK <= value.
+   accel_hi_lt <= stop_jerk_q[D_BITS-1:HALF] < cfg_value[D_BITS-1:HALF];
+   accel_hi_eq <= stop_jerk_q[D_BITS-1:HALF] == cfg_value[D_BITS-1:HALF];
+   accel_lo_le <= stop_jerk_q[HALF-1:0] <= cfg_value[HALF-1:0];
+   accel_nonzero <= stop_jerk_q != {D_BITS{1'b0}};
+   cfg_is_jerk <= cfg_param == P_STOP_JERK;
+   cfg_is_accel <= cfg_param == P_STOP_ACCEL;
+end
+wire jerk_pair_valid = jerk_nonzero && (jerk_hi_lt || (jerk_hi_eq && jerk_lo_le));
+wire accel_pair_valid = accel_nonzero && (accel_hi_lt || (accel_hi_eq && accel_lo_le));
 
 // ---- The frame's decode, a clock ahead -------------------------------------------------------
 // The command, its length and its payload are complete two bytes before the frame is checked,
 // and the registers they are checked against (the parameters) change only when a frame is
-// executed (more than a clock before the next one is) or by a reset (which the frame receiver
-// shares): what depends on them alone is registered on every clock and is exact on the
-// frame's clock (the state is read on that clock itself; the core's outputs a clock earlier,
+// executed (a frame's bytes, at least 40 bit times, before the next one is) or by a reset
+// (which the frame receiver shares): what depends on them alone is registered on every clock
+// (the stop limits' compares in two stages, above) and is exact on the frame's clock (the state is read on that clock itself; the core's outputs a clock earlier,
 // through in_*, and the received CRC on the frame receiver's own clock, through pre_retry).
 reg pre_known = 1'b0;                            // the command is in the table
 reg pre_len_ok = 1'b0;                           // ... and has its payload length
@@ -208,7 +228,7 @@ always @(posedge clock) begin
    endcase
    pre_cfg_at_rest <= param_at_rest(cfg_param);
    pre_cfg_disabled <= param_disabled(cfg_param);
-   pre_cfg_pair_bad <= ((cfg_param == P_STOP_JERK) || (cfg_param == P_STOP_ACCEL)) && !cfg_pair_valid;
+   pre_cfg_pair_bad <= (cfg_is_jerk && !jerk_pair_valid) || (cfg_is_accel && !accel_pair_valid);
    pre_power_on <= arg0 == 8'd1;
    pre_seg_first <= seg_index[ADDR_BITS-1:0] == {ADDR_BITS{1'b0}};
    pre_seg_pos <= !seg_snap[D_BITS-1] && (seg_snap != {D_BITS{1'b0}});
@@ -355,6 +375,12 @@ always @(*) begin
    n_write_ticks = write_ticks_q;
    n_write_snap = write_snap_q;
    n_count_value = count_value_q;
+   // The standby bank emptied for a swap a stop or an abort cancelled on the last clock (a
+   // COMMIT taken on this clock, below, writes the count after it).
+   if (empty_standby_q) begin
+      n_count_enable = 1'b1;
+      n_count_value = {INDEX_BITS{1'b0}};
+   end
    n_reply_kind = reply_kind_q;
    n_reply_cmd = reply_cmd_q;
    n_reply_seq = reply_seq_q;
@@ -576,12 +602,9 @@ always @(*) begin
       n_error = E_EMERGENCY_STOP;
    end
    // A stop or an abort cancels an armed swap, and its program, planned for the swap's tick,
-   // never plays from another state: the standby bank is emptied (a swap sent on either of the
-   // last two clocks counts: the status does not show it yet).
-   if ((n_stop || n_abort) && (in_swap_pending || swap_q || swap_q2)) begin
-      n_count_enable = 1'b1;
-      n_count_value = {INDEX_BITS{1'b0}};
-   end
+   // never plays from another state: the standby bank is emptied on the next clock (a swap
+   // sent on either of the last two clocks counts: the status does not show it yet).
+   n_empty_standby = (n_stop || n_abort) && (in_swap_pending || swap_q || swap_q2);
 
 end
 
@@ -606,6 +629,7 @@ always @(posedge clock) begin
       write_snap_q <= {D_BITS{1'b0}};
       count_enable_q <= 1'b0;
       count_value_q <= {INDEX_BITS{1'b0}};
+      empty_standby_q <= 1'b0;
       start_q <= 1'b0;
       swap_q <= 1'b0;
       swap_last_q <= {SWAP_BITS{1'b0}};
@@ -647,6 +671,7 @@ always @(posedge clock) begin
       write_snap_q <= n_write_snap;
       count_enable_q <= n_count_enable;
       count_value_q <= n_count_value;
+      empty_standby_q <= n_empty_standby;
       start_q <= n_start;
       swap_q <= n_swap;
       swap_last_q <= n_swap_last;
@@ -671,15 +696,21 @@ always @(posedge clock) begin
    end
 end
 
-// READ_CONFIG's value, for the reply transmitter: the parameter read_param names, registered
-// (0 for an unknown one).
+// READ_CONFIG's value, for the reply transmitter: read_param is the parameter its CONFIG reply
+// names after this edge; it is decoded one-hot here (read_sel_q, as the transmitter's own
+// register is taken) and the value of the parameter it selects registered on the next clock,
+// an AND-OR with no 8-bit compare in front of the 104-bit multiplexer (0 for an unknown one).
+reg [PARAM_COUNT-1:0] read_sel_q = {PARAM_COUNT{1'b0}};
 reg [D_BITS-1:0] read_value_q = {D_BITS{1'b0}};
 always @(posedge clock) begin
-   read_value_q <= {D_BITS{1'b0}};
+   read_sel_q <= {PARAM_COUNT{1'b0}};
    case (read_param)
-   //@ param_read
+   //@ param_read_select
    default: ;
    endcase
+   read_value_q <= {D_BITS{1'b0}}
+   //@ param_read
+   ;
 end
 
 always @(*) begin

@@ -122,7 +122,8 @@ end
 
 always @(*) begin
    pop = !reset && launch_head;
-   read_param = aux_q;
+   // The parameter after this edge (the executor registers it decoded, as aux_q takes it).
+   read_param = (!reset && (launch_head || launch_telemetry)) ? head_aux : aux_q;
    fifo_write = writing;
    fifo_data = data;
 end

@@ -157,6 +157,9 @@ pub struct IoCosimReport {
     pub swaps_armed: u64,
     /// Clocks with a swap armed.
     pub swap_pending_clocks: u64,
+    /// Armed swaps cancelled by a stop, a fault or the emergency stop (SWAP_PENDING fell with
+    /// the axis stopping or in ErrorStop: the standby bank is emptied).
+    pub swaps_cancelled: u64,
     /// STOP and HALT commands acknowledged.
     pub stops_acked: u64,
     /// Clocks with a controlled stop running.
@@ -196,6 +199,7 @@ impl IoCosimReport {
         self.moves_started += o.moves_started;
         self.swaps_armed += o.swaps_armed;
         self.swap_pending_clocks += o.swap_pending_clocks;
+        self.swaps_cancelled += o.swaps_cancelled;
         self.stops_acked += o.stops_acked;
         self.stopping_clocks += o.stopping_clocks;
         self.overflow_clocks += o.overflow_clocks;
@@ -386,7 +390,7 @@ pub fn describe(r: &IoCosimReport) -> String {
         .collect();
     let count = |c: u8| IoCosimReport::count(&r.replies, c);
     format!(
-        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} swaps armed ({} clocks armed), {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
+        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} swaps armed ({} clocks armed, {} cancelled), {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
         r.clocks,
         r.frames_sent,
         r.damaged_sent,
@@ -401,6 +405,7 @@ pub fn describe(r: &IoCosimReport) -> String {
         r.moves_started,
         r.swaps_armed,
         r.swap_pending_clocks,
+        r.swaps_cancelled,
         r.stops_acked,
         r.stopping_clocks,
         if errors.is_empty() { "none".into() } else { errors.join(", ") },

@@ -32,6 +32,11 @@ pub(super) struct Stream {
     decoder: Decoder,
     pub(super) report: IoCosimReport,
     last_state: u8,
+    /// SWAP_PENDING on the last clock.
+    last_swap_pending: bool,
+    /// An armed swap was cancelled: START is sent once the axis is in Standstill again, before
+    /// any upload (the standby bank was emptied: NO_PROGRAM).
+    start_after_cancel: bool,
     /// Sequence numbers of START, STOP and HALT frames sent, to count their ACKs.
     pending: VecDeque<(u8, u8)>,
     /// Clocks since the stream began.
@@ -58,6 +63,8 @@ impl Stream {
             decoder: Decoder::new(),
             report: IoCosimReport::default(),
             last_state: 0,
+            last_swap_pending: false,
+            start_after_cancel: false,
             pending: VecDeque::new(),
             now: 0,
             scheduled: None,
@@ -270,6 +277,11 @@ impl Stream {
         let r = &mut self.rng;
         let choice = r.gen_range(0..100);
         let st = dev.status();
+        if self.start_after_cancel && st.state == AxisState::Standstill as u8 {
+            self.start_after_cancel = false;
+            self.send(peer, Command::Start);
+            return;
+        }
         match choice {
             // Get the axis going: stop limits, power, a move.
             0..=14 => {
@@ -462,6 +474,12 @@ impl Stream {
         if st.has(flag::SWAP_PENDING) {
             self.report.swap_pending_clocks += 1;
         }
+        let cancelled = [AxisState::Stopping as u8, AxisState::ErrorStop as u8];
+        if self.last_swap_pending && !st.has(flag::SWAP_PENDING) && cancelled.contains(&st.state) {
+            self.report.swaps_cancelled += 1;
+            self.start_after_cancel = true;
+        }
+        self.last_swap_pending = st.has(flag::SWAP_PENDING);
         if st.state == AxisState::ErrorStop as u8 && self.last_state != st.state {
             IoCosimReport::bump(&mut self.report.errors, st.error);
             // The stalled motor is free again once the fault has stopped it.

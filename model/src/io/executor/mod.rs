@@ -188,6 +188,10 @@ pub struct Executor {
     /// The start, stop and swap pulses sent two clocks ago: the core's status read on this
     /// clock (registered twice, once in the core and once here) does not show them yet.
     older_pulses: [bool; 3],
+    /// A stop or an abort cancelled an armed swap on the last clock: the standby bank is
+    /// emptied on this one (a clock later, so that the stop's decision does not reach the
+    /// count's register in the same clock).
+    empty_standby: bool,
 }
 
 impl Executor {
@@ -253,6 +257,12 @@ impl Executor {
         c.load = false;
         self.out.reply = None;
         self.out.telemetry = false;
+        // The standby bank emptied for a swap cancelled on the last clock (a COMMIT taken on
+        // this clock, below, writes the count after it).
+        if std::mem::take(&mut self.empty_standby) {
+            c.count_enable = true;
+            c.count_value = 0;
+        }
         if i.reset {
             self.out = ExecutorOutputs {
                 config: Config::after_reset(self.tick_div_default, self.polarity_default),
@@ -385,14 +395,11 @@ impl Executor {
             disable_at_once(o, ErrorId::EmergencyStop);
         }
         // A stop or an abort cancels an armed swap, and its program, planned for the swap's
-        // tick, never plays from another state: the standby bank is emptied (a swap sent on
-        // either of the last two clocks counts: the status does not show it yet).
-        if (o.command.stop || o.command.abort_move)
-            && (i.core.swap_pending || before.command.swap || older[2])
-        {
-            o.command.count_enable = true;
-            o.command.count_value = 0;
-        }
+        // tick, never plays from another state: the standby bank is emptied on the next clock
+        // (a swap sent on either of the last two clocks counts: the status does not show it
+        // yet).
+        self.empty_standby = (o.command.stop || o.command.abort_move)
+            && (i.core.swap_pending || before.command.swap || older[2]);
 
         self.swap_lead = swap_tick_field(&live.rx).wrapping_sub(live.core.ticks);
         // (Registered last: the commands above read the value before this clock.)
