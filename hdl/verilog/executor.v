@@ -238,22 +238,36 @@ always @(posedge clock) begin
    //@ param_select
 end
 
-// SWAP_AT: how far its tick lies beyond the time base (the lead: signed, wrap-safe), checked on
-// every clock and registered (the payload is complete two bytes before the frame is): one clock
-// old when the frame is executed, and the core arms one clock later, so the time base may have
-// ticked twice by then; the core wants three ticks of lead. Late: the lead is negative or its
-// bits above LEAD_BITS are 0 and its low bits below SWAP_MIN_LEAD (no second carry chain after
-// the subtraction).
-wire [TIME_BITS-1:0] swap_lead = swap_tick - ticks;
+// SWAP_AT: how far its tick lies beyond the time base (the lead: signed, wrap-safe), as it was
+// on the clock before the frame is executed (the payload is complete two bytes before the
+// frame is); the core arms one clock after the execution, so the time base may have ticked
+// twice by then; the core wants three ticks of lead. In two clocks, with no carry chain after
+// the subtraction: the tick less the time base registered (swap_diff), then the lead is
+// swap_diff less the tick that came with it (in_tick: the time base counts it on the same
+// edge), and its lateness and reach are registered from swap_diff's bits for either case.
+// Late: the lead is negative, or its bits above LEAD_BITS are 0 and its low bits below
+// SWAP_MIN_LEAD. Far (the core compares SWAP_BITS bits): the lead is 2^(SWAP_BITS-1) or more.
+reg [TIME_BITS-1:0] swap_diff = {TIME_BITS{1'b0}};
+always @(posedge clock) swap_diff <= swap_tick - ticks;
+wire diff_neg = swap_diff[TIME_BITS-1];
+wire diff_low_zero = swap_diff[TIME_BITS-2:0] == {(TIME_BITS-1){1'b0}};   // with diff_neg: the minimum
+wire diff_mid_zero = swap_diff[TIME_BITS-2:LEAD_BITS] == {(TIME_BITS-1-LEAD_BITS){1'b0}};
+wire diff_far = swap_diff[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}};
+// The lead is swap_diff: late below SWAP_MIN_LEAD, far from 2^(SWAP_BITS-1).
+wire late_same = diff_neg || (diff_mid_zero && (swap_diff[LEAD_BITS-1:0] < SWAP_MIN_LEAD[LEAD_BITS-1:0]));
+wire far_same = !diff_neg && diff_far;
+// The lead is swap_diff − 1 (wrapping: the minimum becomes the maximum): late up to
+// SWAP_MIN_LEAD, far above 2^(SWAP_BITS-1).
+wire late_ticked = (diff_neg && !diff_low_zero)
+   || (!diff_neg && diff_mid_zero && (swap_diff[LEAD_BITS-1:0] <= SWAP_MIN_LEAD[LEAD_BITS-1:0]));
+wire far_ticked = (diff_neg && diff_low_zero) || (!diff_neg
+   && ((swap_diff[TIME_BITS-2:SWAP_BITS] != {(TIME_BITS-1-SWAP_BITS){1'b0}})
+      || (swap_diff[SWAP_BITS-1] && (swap_diff[SWAP_BITS-2:0] != {(SWAP_BITS-1){1'b0}}))));
 reg swap_late_q = 1'b1;
-// The core compares SWAP_BITS bits: a tick 2^(SWAP_BITS-1) ticks or more ahead is refused.
 reg swap_far_q = 1'b0;
 always @(posedge clock) begin
-   swap_late_q <= reset || swap_lead[TIME_BITS-1]
-      || ((swap_lead[TIME_BITS-2:LEAD_BITS] == {(TIME_BITS-1-LEAD_BITS){1'b0}})
-         && (swap_lead[LEAD_BITS-1:0] < SWAP_MIN_LEAD[LEAD_BITS-1:0]));
-   swap_far_q <= !reset && !swap_lead[TIME_BITS-1]
-      && (swap_lead[TIME_BITS-2:SWAP_BITS-1] != {(TIME_BITS-SWAP_BITS){1'b0}});
+   swap_late_q <= reset || (in_tick ? late_ticked : late_same);
+   swap_far_q <= !reset && (in_tick ? far_ticked : far_same);
 end
 wire [SWAP_BITS-1:0] swap_before = swap_tick[SWAP_BITS-1:0] - 1'b1;   // the core's swap_last: T − 1
 wire toward_limit = (first_pos_q && in_limit_pos) || (first_neg_q && in_limit_neg);

@@ -84,6 +84,7 @@ always @(posedge clock) begin
       index_q <= 8'd0;
       pending_q <= 1'b0;
       load_q <= 2'd0;
+      at_payload_q <= 1'b0;
    end else begin
       // The payload, {{PAYLOAD_DELAY}} clocks after the start (the shift below starts at index 4).
       if (load_q == 2'd1) payload_q <= new_payload;
@@ -108,7 +109,6 @@ always @(posedge clock) begin
       end else if (writing) begin
          // (The CRC covers bytes 1 to len + 3: every byte but the start and the CRC's own.)
          if ((index_q != 8'd0) && !at_crc_lo_q && !at_last_q) crc_q <= crc16_step(crc_q, data);
-         if (at_payload_q) payload_q <= payload_q >> 8;
          index_q <= index_next;
          at_payload_q <= (index_next >= 8'd4) && (index_next < end_q);
          at_crc_lo_q <= index_next == end_q;
@@ -118,6 +118,10 @@ always @(posedge clock) begin
       if (launch_telemetry) pending_q <= 1'b0;
       else if (telemetry) pending_q <= 1'b1;
    end
+   // A payload byte written: the payload shifts (at_payload_q is set only while a frame is
+   // written: cleared at its start, after its payload and on reset, so its enable is that
+   // register and the FIFO's full flag alone).
+   if (!reset && at_payload_q && !fifo_full) payload_q <= payload_q >> 8;
 end
 
 always @(*) begin

@@ -186,6 +186,11 @@ impl Device {
         &self.core
     }
 
+    /// The command executor's outputs (its reply pulse marks the clock a frame is executed).
+    pub fn executor_outputs(&self) -> crate::io::executor::ExecutorOutputs {
+        self.exec.outputs()
+    }
+
     /// True while part of a frame has been received.
     pub fn mid_frame(&self) -> bool {
         self.frame_rx.mid_frame()

@@ -73,6 +73,11 @@ fn random_command_streams_match_bit_for_bit() {
     assert!(r.swaps_armed >= 10, "{} swaps armed", r.swaps_armed);
     // (A cancelled swap empties the standby bank, a clock after the stop.)
     assert!(r.swaps_cancelled > 0, "no armed swap was cancelled");
+    // (SWAP_AT's lateness check at its edge, with the time base ticking just before it.)
+    assert!(
+        r.swaps_aimed > 0,
+        "no SWAP_AT was sent at the lateness edge"
+    );
     assert!(r.stops_acked >= 10, "{} stops", r.stops_acked);
     assert!(r.stopping_clocks > 10_000);
     assert!(r.overflow_clocks > 0, "the reply queue never overflowed");

@@ -160,6 +160,9 @@ pub struct IoCosimReport {
     /// Armed swaps cancelled by a stop, a fault or the emergency stop (SWAP_PENDING fell with
     /// the axis stopping or in ErrorStop: the standby bank is emptied).
     pub swaps_cancelled: u64,
+    /// SWAP_AT frames sent with their tick at the edge of the lateness check (1 tick below
+    /// it, on it or above it), timed so that the time base ticks just before the check.
+    pub swaps_aimed: u64,
     /// STOP and HALT commands acknowledged.
     pub stops_acked: u64,
     /// Clocks with a controlled stop running.
@@ -200,6 +203,7 @@ impl IoCosimReport {
         self.swaps_armed += o.swaps_armed;
         self.swap_pending_clocks += o.swap_pending_clocks;
         self.swaps_cancelled += o.swaps_cancelled;
+        self.swaps_aimed += o.swaps_aimed;
         self.stops_acked += o.stops_acked;
         self.stopping_clocks += o.stopping_clocks;
         self.overflow_clocks += o.overflow_clocks;
@@ -390,7 +394,7 @@ pub fn describe(r: &IoCosimReport) -> String {
         .collect();
     let count = |c: u8| IoCosimReport::count(&r.replies, c);
     format!(
-        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} swaps armed ({} clocks armed, {} cancelled), {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
+        "{} clocks; sent {} frames and {} damaged ones; received {} ACK, {} NAK ({}), {} STATUS, {} STATE, {} IDENTITY, {} CONFIG, {} TELEMETRY; {} moves started, {} swaps armed ({} clocks armed, {} cancelled, {} sent at the lateness edge), {} stops acknowledged, {} clocks stopping; ErrorStop entries: {}; {} clocks with the reply overflow flag",
         r.clocks,
         r.frames_sent,
         r.damaged_sent,
@@ -406,6 +410,7 @@ pub fn describe(r: &IoCosimReport) -> String {
         r.swaps_armed,
         r.swap_pending_clocks,
         r.swaps_cancelled,
+        r.swaps_aimed,
         r.stops_acked,
         r.stopping_clocks,
         if errors.is_empty() { "none".into() } else { errors.join(", ") },

@@ -16,6 +16,7 @@ use snapgen_model::format::Quantity;
 use snapgen_model::peer::Peer;
 use snapgen_model::{Format, Segment};
 use snapgen_plan::{plan_from, Method, MoveRequest};
+use snapgen_spec::rules::SWAP_MIN_LEAD;
 
 use super::IoCosimReport;
 
@@ -316,7 +317,15 @@ impl Stream {
             }
             38..=49 => {
                 let c = random_command(r, &self.design.format, dev.core().outputs().ticks);
-                self.send(peer, c);
+                if (matches!(c, Command::SwapAt { .. }) || self.rng.gen_bool(0.1))
+                    && self.scheduled.is_none()
+                    && self.release.iter().all(Option::is_none)
+                    && self.rng.gen_bool(0.7)
+                {
+                    self.schedule_swap_at_the_edge(peer, dev);
+                } else {
+                    self.send(peer, c);
+                }
             }
             50..=54 => {
                 // A burst of reads, sometimes past the reply queue.
@@ -429,6 +438,50 @@ impl Stream {
                 4..=7 => self.rng.gen_range(1..300),
                 _ => log_uniform(&mut self.rng, 300.0, 20_000.0) as u64,
             };
+        }
+    }
+
+    /// A SWAP_AT aimed at the edge of its lateness check: copies of the device and of the
+    /// host's line are run ahead with the frame sent after 1 to 16 clocks (the clocks until
+    /// it is executed do not depend on the tick it carries), a delay is chosen for which the
+    /// time base ticked on the clock before the one whose time base the check reads (the
+    /// fabric then corrects its registered difference by that tick), and the frame is
+    /// scheduled with its tick SWAP_MIN_LEAD − 1, SWAP_MIN_LEAD or SWAP_MIN_LEAD + 1 ticks
+    /// beyond that time base: LATE, armed, armed (docs/PROTOCOL.md). Nothing is sent when no
+    /// delay gives that.
+    fn schedule_swap_at_the_edge(&mut self, peer: &Peer, dev: &Device) {
+        let frame = Command::SwapAt { tick: 0 }.to_frame(0, &self.design.format);
+        let bytes = frame.to_bytes();
+        let airtime = bytes.len() as u64 * 10 * u64::from(self.design.dividers.uart_divisor);
+        for delay in 1..=16u64 {
+            let (mut p, mut d) = (peer.clone(), dev.clone());
+            // The time base before each clock's edge (what the executor reads live).
+            let mut ticks: Vec<u64> = Vec::new();
+            for k in 0..delay + airtime + 200 {
+                if k == delay {
+                    p.send(&bytes);
+                }
+                ticks.push(d.core().outputs().ticks);
+                let o = d.clock(&p.inputs());
+                p.observe(&o);
+                if d.executor_outputs()
+                    .reply
+                    .is_some_and(|r| r.cmd == code::SWAP_AT)
+                {
+                    // Executed on clock e: the check reads the time base of clock e − 1.
+                    let e = ticks.len() - 1;
+                    if e >= 2 && ticks[e - 1] == ticks[e - 2] + 1 {
+                        let lead = SWAP_MIN_LEAD as u64 + self.rng.gen_range(0..3) - 1;
+                        let tick = ticks[e - 1] + lead;
+                        self.scheduled = Some((self.now + delay, Command::SwapAt { tick }));
+                        // (Nothing else is sent before it.)
+                        self.wait = delay;
+                        self.report.swaps_aimed += 1;
+                        return;
+                    }
+                    break;
+                }
+            }
         }
     }
 
