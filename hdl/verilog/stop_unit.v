@@ -26,7 +26,6 @@ localparam [1:0] C_AND = 2'd2, C_OR = 2'd3;
 //@ flag_names
 reg [2:0] phase = PH_IDLE;
 reg ready_q = 1'b0;                      // phase == PH_READY, registered with it
-reg active_q = 1'b0;                     // phase != PH_IDLE, registered with it
 reg [6:0] pc = 7'd0;
 reg [{{IR_TOP}}:0] ir = {{IR_HALT}};              // the instruction at pc (and its first_reads)
 reg [1:0] step = 2'd0;
@@ -232,10 +231,24 @@ always @(posedge clock) begin : engine
          next_new = 1'b1;
          fetch = 1'b1;
       end
-      // Init and Decide were fetched when the engine halted into ARMED and READY: the stop
-      // and the tick only set the phase (they reach no register of the engine).
-      PH_ARMED: if (engage) phase <= PH_RUN;
-      PH_READY: if (tick) phase <= PH_RUN;
+      PH_ARMED: if (engage) begin
+         phase <= PH_RUN;
+         step_next = 2'd0;
+         pc_next = PC_INIT;
+         ir_next = rom(PC_INIT);
+         ir_inc_next = rom(PC_INIT + 7'd1);
+         next_new = 1'b1;
+         fetch = 1'b1;
+      end
+      PH_READY: if (tick) begin
+         phase <= PH_RUN;
+         step_next = 2'd0;
+         pc_next = PC_DECIDE;
+         ir_next = rom(PC_DECIDE);
+         ir_inc_next = rom(PC_DECIDE + 7'd1);
+         next_new = 1'b1;
+         fetch = 1'b1;
+      end
       default: if (running) begin
          case (i_kind)
          K_LOOP: begin
@@ -293,37 +306,16 @@ always @(posedge clock) begin : engine
             step_next = last ? 2'd0 : step + 2'd1;
          end
          K_HALT: begin
-            // Prep done, or a decision made (or the chain found at rest). The entry point the
-            // unit runs next (Init once the stop is taken, Decide on the next tick) is fetched
-            // now.
-            if (phase == PH_PREP) begin
-               phase <= PH_ARMED;
-               step_next = 2'd0;
-               pc_next = PC_INIT;
-               ir_next = rom(PC_INIT);
-               ir_inc_next = rom(PC_INIT + 7'd1);
-               next_new = 1'b1;
-               fetch = 1'b1;
-            end else if (flags[F_REST]) phase <= PH_IDLE;
-            else begin
-               phase <= PH_READY;
-               step_next = 2'd0;
-               pc_next = PC_DECIDE;
-               ir_next = rom(PC_DECIDE);
-               ir_inc_next = rom(PC_DECIDE + 7'd1);
-               next_new = 1'b1;
-               fetch = 1'b1;
-            end
+            // Prep done, or a decision made (or the chain found at rest).
+            if (phase == PH_PREP) phase <= PH_ARMED;
+            else if (flags[F_REST]) phase <= PH_IDLE;
+            else phase <= PH_READY;
          end
          default: ;
          endcase
       end
       endcase
    end
-   // The phase after this edge is not IDLE (the core's start gate and the swap timer read it
-   // from a register, not through a compare of the phase).
-   active_q <= !reset && !cancel && ((phase == PH_IDLE) ? request
-      : !((phase == PH_RUN) && (i_kind == K_HALT) && flags[F_REST]));
    // The phase after this edge is READY (the chain's snap multiplexer reads it from a register).
    ready_q <= !reset && !cancel && (((phase == PH_READY) && !tick)
       || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags[F_REST]));
@@ -338,14 +330,8 @@ always @(posedge clock) begin : engine
    step_last <= step_next == 2'd3;
    // The read addresses of the next clock: a new instruction's first (step 0) from its ROM
    // word, else this instruction's at the step after this edge.
-   // (Held while the engine waits in ARMED or READY: the fetched entry point's.)
-   if (next_new) begin
-      ra_q <= ir_next[{{IR_TOP}}:{{RA0_LO}}];
-      rb_q <= ir_next[{{RB0_HI}}:{{RB0_LO}}];
-   end else if (running) begin
-      ra_q <= {i_a_src[3:0], a_word(i_a_mod, step_next)};
-      rb_q <= {i_b_reg, read_word(i_a_mod, step_next)};
-   end
+   ra_q <= next_new ? ir_next[{{IR_TOP}}:{{RA0_LO}}] : {i_a_src[3:0], a_word(i_a_mod, step_next)};
+   rb_q <= next_new ? ir_next[{{RB0_HI}}:{{RB0_LO}}] : {i_b_reg, read_word(i_a_mod, step_next)};
 end
 
 // ---- Heading (for the limit switches) and at rest, registered: the sign of v, else a, else j --
@@ -364,7 +350,7 @@ always @(posedge clock) begin
 end
 
 always @(*) begin
-   active = active_q;
+   active = phase != PH_IDLE;
    armed = phase == PH_ARMED;
    computing = phase == PH_RUN;
    // The phase after this edge is RUN (the tick divider's register is told it).
