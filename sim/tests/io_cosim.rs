@@ -10,7 +10,9 @@ use snapgen_sim::io_cosim::{cosim_design, describe, run, IoCosimConfig, IoCosimR
 /// exercised on the way.
 #[test]
 fn random_command_streams_match_bit_for_bit() {
-    let r = run(&cosim_design(), &IoCosimConfig::new(4_000_000, 14, 2)).unwrap();
+    // (Seed 17: a stream that reaches every path asserted below; seed 14, used before the
+    // stream aimed SWAP_AT frames at the lateness edge, no longer reaches a following error.)
+    let r = run(&cosim_design(), &IoCosimConfig::new(4_000_000, 17, 2)).unwrap();
     eprintln!("{}", describe(&r));
     assert_eq!(r.mismatch, None);
     assert!(r.clocks >= 8_000_000, "only {} clocks", r.clocks);
