@@ -350,6 +350,13 @@ wire executes = in_frame && !in_bad_crc && !in_dropped && !in_queue_full && pre_
 function automatic taken(input [7:0] c, input [STATE_BITS-1:0] st);
    taken = executes && (in_cmd == c) && (refusal(c, st) == 8'd0);
 endfunction
+// The prescaler completes a millisecond on this clock (prescale_q + 1 >= CLOCKS_PER_MS),
+// registered: taken on the clock before from what the prescaler does then (it restarts at 0
+// on reset, a frame or a completed millisecond, else counts up by one).
+reg prescale_due_q = (CLOCKS_PER_MS <= 32'd1);
+always @(posedge clock)
+   prescale_due_q <= (reset || in_frame || prescale_due_q) ? (CLOCKS_PER_MS <= 32'd1)
+                                                            : (prescale_q + 32'd2 >= CLOCKS_PER_MS);
 // The watchdog expired (registered: the count compared on the clock before decides).
 reg expired = 1'b0;
 always @(posedge clock)
@@ -429,7 +436,7 @@ always @(*) begin
    if (in_frame) begin
       n_prescale = 32'd0;
       n_watchdog_count = {WATCHDOG_MS_BITS{1'b0}};
-   end else if (prescale_q + 32'd1 >= CLOCKS_PER_MS) begin
+   end else if (prescale_due_q) begin
       n_prescale = 32'd0;
       if (watchdog_count_q != {WATCHDOG_MS_BITS{1'b1}}) n_watchdog_count = watchdog_count_q + 1'b1;
    end
