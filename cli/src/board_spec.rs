@@ -27,6 +27,31 @@ pub fn top_ports() -> Vec<(String, Direction, &'static str)> {
 /// Yosys `synth_xilinx` families Vivado can also build (7 series and UltraScale).
 pub const FAMILIES: [&str; 3] = ["xc7", "xcu", "xcup"];
 
+/// The Lattice ECP5 family: built here with the open toolchain (Yosys `synth_ecp5`,
+/// nextpnr-ecp5, ecppack; [`crate::ecp5`]).
+pub const ECP5: &str = "ecp5";
+
+/// How a board's bitstream is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Toolchain {
+    /// Vivado (AMD/Xilinx), not available here: the build is written, `--run` runs it.
+    Vivado,
+    /// The open ECP5 flow, run by `snapgen build`.
+    OpenEcp5,
+}
+
+/// A pin's pull resistor inside the FPGA.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Pull {
+    /// Pull-up.
+    Up,
+    /// Pull-down.
+    Down,
+    /// None.
+    None,
+}
+
 /// A pin's direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -55,10 +80,12 @@ pub struct DeviceResources {
     pub luts: u64,
     /// Flip-flops.
     pub ffs: u64,
-    /// DSP48E1 slices.
-    pub dsp48e1: u64,
-    /// 36 kb block RAMs.
-    pub bram36: u64,
+    /// DSP48E1 slices (Xilinx boards).
+    #[serde(default)]
+    pub dsp48e1: Option<u64>,
+    /// 36 kb block RAMs (Xilinx boards).
+    #[serde(default)]
+    pub bram36: Option<u64>,
 }
 
 /// The board clock.
@@ -71,8 +98,12 @@ pub struct ClockPin {
     pub pin: String,
     /// I/O standard.
     pub iostandard: String,
-    /// Frequency (Hz).
+    /// The oscillator's frequency (Hz).
     pub frequency_hz: u64,
+    /// The fabric clock the FPGA's PLL makes from the oscillator (Hz; ECP5 boards). Without
+    /// it the fabric runs at the oscillator's frequency.
+    #[serde(default)]
+    pub pll_hz: Option<u64>,
 }
 
 /// A named pin.
@@ -87,6 +118,9 @@ pub struct Pin {
     pub iostandard: String,
     /// `in` or `out`.
     pub direction: Direction,
+    /// The FPGA's pull resistor on it (default: the device's default).
+    #[serde(default)]
+    pub pull: Option<Pull>,
     /// What it is for.
     pub comment: String,
 }
@@ -99,9 +133,9 @@ pub struct Board {
     pub name: String,
     /// Human description.
     pub description: String,
-    /// Vivado part.
+    /// The vendor's part name (Vivado's part for a Xilinx board).
     pub part: String,
-    /// Yosys `synth_xilinx` family.
+    /// Yosys `synth_xilinx` family (`xc7`, `xcu`, `xcup`) or `ecp5`.
     pub family: String,
     /// Device.
     pub device: String,
@@ -163,7 +197,10 @@ pub enum BoardError {
     },
 }
 
-const BUILTIN: &[(&str, &str)] = &[("zybo-z7-10", include_str!("../boards/zybo-z7-10.toml"))];
+const BUILTIN: &[(&str, &str)] = &[
+    ("zybo-z7-10", include_str!("../boards/zybo-z7-10.toml")),
+    ("ulx3s", include_str!("../boards/ulx3s.toml")),
+];
 
 /// A built-in board by name.
 pub fn builtin(name: &str) -> Result<Board, BoardError> {
@@ -215,6 +252,20 @@ impl Board {
         format!("snapgen_{}", self.name.replace('-', "_"))
     }
 
+    /// How its bitstream is built.
+    pub fn toolchain(&self) -> Toolchain {
+        if self.family == ECP5 {
+            Toolchain::OpenEcp5
+        } else {
+            Toolchain::Vivado
+        }
+    }
+
+    /// The fabric's clock (Hz): the PLL's output, else the oscillator's.
+    pub fn fabric_clock_hz(&self) -> u64 {
+        self.clock.pll_hz.unwrap_or(self.clock.frequency_hz)
+    }
+
     fn check(&self, origin: &str) -> Result<(), BoardError> {
         let bad = |field: &str, value: &dyn std::fmt::Display, fix: &str| BoardError::Invalid {
             origin: origin.to_string(),
@@ -249,15 +300,52 @@ impl Board {
                 ));
             }
         }
-        if !FAMILIES.contains(&self.family.as_str()) {
+        if !FAMILIES.contains(&self.family.as_str()) && self.family != ECP5 {
             return Err(bad(
                 "family",
                 &self.family,
                 &format!(
-                    "use one of {} (Yosys synth_xilinx families that Vivado builds)",
+                    "use one of {} (Yosys synth_xilinx families that Vivado builds) or {ECP5} (built here with Yosys, nextpnr-ecp5 and ecppack)",
                     FAMILIES.join(", ")
                 ),
             ));
+        }
+        match self.toolchain() {
+            Toolchain::OpenEcp5 => {
+                if crate::ecp5::nextpnr_device(&self.device).is_none() {
+                    return Err(bad(
+                        "device",
+                        &self.device,
+                        &format!(
+                            "give an ECP5 device nextpnr-ecp5 knows: {}",
+                            crate::ecp5::DEVICES
+                        ),
+                    ));
+                }
+                if !["6", "7", "8"].contains(&self.speed_grade.as_str()) {
+                    return Err(bad(
+                        "speed_grade",
+                        &self.speed_grade,
+                        "give the ECP5's speed grade: \"6\", \"7\" or \"8\" (the digit after the device in the part name)",
+                    ));
+                }
+            }
+            Toolchain::Vivado => {
+                if self.resources.dsp48e1.is_none() || self.resources.bram36.is_none() {
+                    return Err(bad(
+                        "resources",
+                        &"dsp48e1 or bram36 missing",
+                        "give the device's DSP48E1 and 36 kb block RAM counts (snapgen synth prints the share of each)",
+                    ));
+                }
+                if self.clock.pll_hz.is_some() {
+                    return Err(bad(
+                        "clock.pll_hz",
+                        &self.clock.pll_hz.unwrap_or_default(),
+                        "a PLL is generated for ECP5 boards only: remove pll_hz (the fabric runs at frequency_hz), or give the clock you feed the board",
+                    ));
+                }
+            }
         }
         if self.input_polarity > 7 {
             return Err(bad(
@@ -288,6 +376,11 @@ impl Board {
                 &c.frequency_hz,
                 "give the oscillator's frequency in Hz, 1e6 to 1e9",
             ));
+        }
+        if let Some(pll) = c.pll_hz {
+            if let Err(e) = crate::ecp5::solve_pll(c.frequency_hz, pll) {
+                return Err(bad("clock.pll_hz", &pll, &e.to_string()));
+            }
         }
         let mut pins: BTreeMap<&str, &str> = BTreeMap::new();
         let mut ports: BTreeMap<&str, Direction> = BTreeMap::new();
@@ -437,6 +530,42 @@ mod tests {
             let e = zybo_with(edit).unwrap_err().to_string();
             assert!(e.contains(want), "{want:?} not in: {e}");
             assert!(e.contains("test.toml"), "{e}");
+        }
+    }
+
+    #[test]
+    fn ecp5_boards_are_checked_too() {
+        let b = builtin("ulx3s").unwrap();
+        assert_eq!(b.toolchain(), Toolchain::OpenEcp5);
+        assert_eq!(
+            (b.clock.frequency_hz, b.fabric_clock_hz()),
+            (25_000_000, 75_000_000)
+        );
+        let ulx3s = BUILTIN[1].1;
+        let cases: [(String, &str); 4] = [
+            (
+                ulx3s.replace("device = \"LFE5U-85F\"", "device = \"LFE5U-100F\""),
+                "give an ECP5 device nextpnr-ecp5 knows",
+            ),
+            (
+                ulx3s.replace("speed_grade = \"6\"", "speed_grade = \"-6\""),
+                "give the ECP5's speed grade",
+            ),
+            (
+                ulx3s.replace("pll_hz = 75000000", "pll_hz = 77777777"),
+                "no ECP5 PLL setting makes exactly 77777777 Hz",
+            ),
+            (
+                BUILTIN[0].1.replace(
+                    "frequency_hz = 125000000",
+                    "frequency_hz = 125000000\npll_hz = 100000000",
+                ),
+                "a PLL is generated for ECP5 boards only",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = Board::parse(&text, "test.toml").unwrap_err().to_string();
+            assert!(e.contains(want), "{want:?} not in: {e}");
         }
     }
 

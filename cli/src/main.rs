@@ -9,6 +9,7 @@
 mod args;
 mod board_spec;
 mod commands;
+mod ecp5;
 mod error;
 mod fpga;
 mod report;

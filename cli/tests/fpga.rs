@@ -273,3 +273,110 @@ fn synth_keeps_the_motion_core_within_budget() {
     assert!(text.contains("| path core for 4 axes"), "{text}");
     assert!(text.contains("| step/dir generator of one axis"), "{text}");
 }
+
+/// The ULX3S's open-toolchain build, written without running it: the constraints carry the
+/// board's pins, pulls and oscillator; the board top makes the fabric clock with the ECP5's
+/// PLL and lints clean with the rest (an EHXPLLL stand-in for Verilator, which does not know
+/// the primitive); the Makefile holds the steps `snapgen build` runs. Place and route and the
+/// bitstream themselves run in the test command (scripts/route.sh), which fails when routed
+/// timing does not close.
+#[test]
+fn build_writes_an_open_ecp5_build() {
+    let dir = tmp("ulx3s");
+    let out = snapgen(&[
+        "build",
+        "--board",
+        "ulx3s",
+        "--files-only",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_ok(&out);
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
+    let lpf = read("snapgen_ulx3s.lpf");
+    assert!(lpf.contains("FREQUENCY PORT \"sysclk\" 25 MHZ;"), "{lpf}");
+    // ULX3S facts (emard/ulx3s ulx3s_v20.lpf): the oscillator, the FT231X's lines, FIRE1,
+    // the LEDs and header J1.
+    for (port, site) in [
+        ("sysclk", "G2"),
+        ("uart_txd", "L4"),
+        ("uart_rxd", "M1"),
+        ("btn_reset", "R1"),
+        ("led[0]", "B2"),
+        ("led[3]", "D2"),
+        ("pwm", "B11"),
+        ("enc_i", "A7"),
+    ] {
+        let line = format!("LOCATE COMP \"{port}\" SITE \"{site}\";");
+        assert!(lpf.contains(&line), "missing {line}");
+    }
+    assert!(lpf.contains("IOBUF PORT \"estop\" IO_TYPE=LVCMOS33 PULLMODE=UP;"));
+    assert!(lpf.contains("IOBUF PORT \"btn_reset\" IO_TYPE=LVCMOS33 PULLMODE=DOWN;"));
+    let top = read("snapgen_ulx3s.v");
+    for want in [
+        ".CLKI_DIV(1)",
+        ".CLKFB_DIV(3)",
+        ".CLKOP_DIV(8)",
+        ".clock(clk)",
+        "btn_reset | !pll_locked",
+        "Clock 75 MHz",
+    ] {
+        assert!(top.contains(want), "board top lacks {want}");
+    }
+    let make = read("Makefile");
+    for want in [
+        "synth_ecp5 -top snapgen_ulx3s",
+        "$(NEXTPNR) --85k --package CABGA381 --speed 6",
+        "--lpf snapgen_ulx3s.lpf",
+        "$(ECPPACK) --compress snapgen_ulx3s.config snapgen_ulx3s.bit",
+    ] {
+        assert!(make.contains(want), "Makefile lacks {want}");
+    }
+    std::fs::write(
+        dir.join("EHXPLLL.v"),
+        "// A stand-in for the ECP5 PLL primitive, for the lint only.\n\
+         `default_nettype none\n\
+         /* verilator lint_off UNUSEDPARAM */ // only the ports are linted\n\
+         /* verilator lint_off UNUSEDSIGNAL */ // only the ports are linted\n\
+         module EHXPLLL #(parameter PLLRST_ENA = \"\", INTFB_WAKE = \"\", STDBY_ENABLE = \"\",\n\
+           DPHASE_SOURCE = \"\", OUTDIVIDER_MUXA = \"\", CLKOP_ENABLE = \"\", FEEDBK_PATH = \"\",\n\
+           integer CLKI_DIV = 1, CLKFB_DIV = 1, CLKOP_DIV = 1, CLKOP_CPHASE = 0, CLKOP_FPHASE = 0) (\n\
+           input wire CLKI, CLKFB, RST, STDBY, PHASESEL0, PHASESEL1, PHASEDIR, PHASESTEP,\n\
+           input wire PHASELOADREG, PLLWAKESYNC, ENCLKOP,\n\
+           output wire CLKOP, LOCK);\n\
+           assign CLKOP = CLKI;\n\
+           assign LOCK = 1'b1;\n\
+         endmodule\n\
+         /* verilator lint_on UNUSEDSIGNAL */\n\
+         /* verilator lint_on UNUSEDPARAM */\n\
+         `default_nettype wire\n",
+    )
+    .unwrap();
+    let files: Vec<String> = [
+        "EHXPLLL.v",
+        "snapgen_core.v",
+        "snapgen_io.v",
+        "snapgen_ulx3s.v",
+    ]
+    .map(String::from)
+    .to_vec();
+    lint_clean(&dir, "snapgen_ulx3s", &files);
+    // A fabric clock the PLL cannot make exactly is refused (exit 2) with the nearest ones.
+    let out = snapgen(&[
+        "build",
+        "--board",
+        "ulx3s",
+        "--files-only",
+        "--clock-hz",
+        "77000000",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("no ECP5 PLL setting makes exactly 77000000 Hz"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,9 +1,12 @@
-//! `snapgen build`: a board build — board top, I/O top, motion core, XDC, Vivado TCL and
-//! Makefile — written for a board (`--run` runs it with Vivado).
+//! `snapgen build`: a board build written for a board — board top, I/O top, motion core and
+//! the toolchain's files. An ECP5 board's open flow (Yosys, nextpnr-ecp5, ecppack) runs here
+//! and writes the `.bit`, failing when routed timing does not close (`--files-only` skips it);
+//! a Xilinx board's Vivado build (XDC, TCL, Makefile) runs with `--run`.
 
 use std::path::PathBuf;
 
 use crate::args::{BoardArgs, TimingArgs};
+use crate::board_spec::Toolchain;
 
 /// Write a board build.
 #[derive(clap::Args)]
@@ -13,9 +16,13 @@ pub struct Args {
     /// Output directory [default: out/BOARD].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Run the build (needs Vivado, $VIVADO or on the PATH).
+    /// Run a Vivado build (Xilinx boards; needs Vivado, $VIVADO or on the PATH). An ECP5
+    /// board's open flow runs without it.
     #[arg(long)]
     run: bool,
+    /// Write an ECP5 board's files only, without running its flow.
+    #[arg(long)]
+    files_only: bool,
     #[command(flatten)]
     timing: TimingArgs,
 }
@@ -25,16 +32,41 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let b = a.board.load()?;
     let (t, d) = a
         .timing
-        .resolve(Some(b.clock.frequency_hz), b.input_polarity)?;
+        .resolve(Some(b.fabric_clock_hz()), b.input_polarity)?;
     let out = a.out.unwrap_or_else(|| PathBuf::from("out").join(&b.name));
-    let plan = crate::fpga::build_plan(&b, &t, &d);
+    let plan = crate::fpga::build_plan(&b, &t, &d)?;
     for f in plan.write(&out)? {
         println!("wrote {}", f.display());
     }
-    if a.run {
-        plan.run(&out)?;
-    } else {
-        println!("run it with: make -C {} (needs Vivado)", out.display());
+    let run = match b.toolchain() {
+        Toolchain::Vivado => a.run,
+        Toolchain::OpenEcp5 => !a.files_only,
+    };
+    if !run {
+        let needs = match b.toolchain() {
+            Toolchain::Vivado => "Vivado",
+            Toolchain::OpenEcp5 => "Yosys, nextpnr-ecp5 and ecppack",
+        };
+        println!("run it with: make -C {} (needs {needs})", out.display());
+        return Ok(());
+    }
+    if let Some(r) = plan.run(&out)? {
+        let top = b.top_name();
+        println!(
+            "wrote {}: routed Fmax {:.2} MHz for the {:.2} MHz fabric clock on the {} (speed {}, nextpnr seed {}): closes, {:.0} % of the period spare; {} of {} LUT4 ({:.1} %), {} of {} FF",
+            out.join(format!("{top}.bit")).display(),
+            r.fmax_mhz,
+            r.target_mhz,
+            b.device,
+            b.speed_grade,
+            crate::ecp5::SEED,
+            100.0 * r.margin(),
+            r.luts.0,
+            r.luts.1,
+            100.0 * r.luts.0 as f64 / r.luts.1 as f64,
+            r.ffs.0,
+            r.ffs.1
+        );
     }
     Ok(())
 }

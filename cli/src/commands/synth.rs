@@ -17,7 +17,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let b = a.board.load()?;
     let (t, d) = a
         .timing
-        .resolve(Some(b.clock.frequency_hz), b.input_polarity)?;
+        .resolve(Some(b.fabric_clock_hz()), b.input_polarity)?;
     let r = crate::fpga::synth(&b, &t, &d)?;
     print!("{}", r.table());
     let v = r.violations();
