@@ -2,8 +2,9 @@
 # The project's test command (README, CI): installs what the tests need when it is missing
 # (scripts/setup.sh), then checks formatting and lints, runs every test, checks routed timing
 # of the blocks that must close it on their own (scripts/route.sh), checks that the ARM64
-# host build plans bit-identically under emulation (scripts/arm64.sh) and that the crates build
-# with their rust-version (scripts/msrv.sh).
+# host build plans bit-identically under emulation (scripts/arm64.sh), builds and tests the
+# Python package (scripts/python.sh) and checks that the crates build with their rust-version
+# (scripts/msrv.sh).
 #
 #   ./scripts/test.sh            # everything
 #   PROPTEST_CASES=20000 ./scripts/test.sh   # more random cases
@@ -28,5 +29,7 @@ echo "== routed timing"
 ./scripts/route.sh
 echo "== arm64 host"
 ./scripts/arm64.sh
+echo "== Python package"
+./scripts/python.sh
 echo "== minimum Rust version"
 ./scripts/msrv.sh

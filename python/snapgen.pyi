@@ -1,0 +1,83 @@
+"""snapgen's planners: rest-to-rest moves, exact on the integer chain of the snapgen FPGA core.
+
+The state at time t is the state after floor(t / ts) ticks, clamped to the move (the fabric's
+output holds between ticks). Positions are in units from the start, velocities in units/s, ...
+"""
+
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+DEFAULT_TS: float
+"""The tick period the board runs after reset (s)."""
+DEFAULT_LSB: float
+"""The default size of one output position LSB (units)."""
+
+class PlanError(ValueError):
+    """A move that cannot be planned; the message says what to change."""
+
+class Trajectory:
+    """A planned move: the program the fabric plays and the trajectory it makes."""
+
+    @property
+    def duration(self) -> float:
+        """The move's duration (s): its ticks times ts."""
+    @property
+    def ticks(self) -> int:
+        """The move's length in ticks."""
+    @property
+    def ts(self) -> float:
+        """The tick period (s)."""
+    @property
+    def order(self) -> int:
+        """4 (snap-limited), 3 (jerk-limited) or 2 (acceleration-limited)."""
+    @property
+    def target_position(self) -> float:
+        """Where the move ends (units from the start): the distance on the LSB grid."""
+    @property
+    def program(self) -> List[Tuple[int, int]]:
+        """(ticks, raw snap) per segment, as the fabric plays them."""
+    @property
+    def start_registers(self) -> Tuple[int, int, int, int]:
+        """The chain's raw (x, v, a, j) before the move."""
+    def registers_at(self, tick: int) -> Tuple[int, int, int, int]:
+        """The chain's raw (x, v, a, j) after `tick` ticks (the final state past the end)."""
+    def scale(self, quantity: str) -> float:
+        """Raw value per physical unit of "position", "velocity", "acceleration", "jerk", "snap"."""
+    def at_time(self, t: float) -> Tuple[float, float, float, float]:
+        """Position, velocity, acceleration and jerk at time t (s)."""
+    def at_times(
+        self, times: npt.NDArray[np.float64]
+    ) -> Tuple[
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+    ]:
+        """at_time for each time of a 1-D array: four arrays of its length."""
+    def peaks(self) -> Dict[str, float]:
+        """The largest |velocity|, |acceleration|, |jerk| and |snap| over the move."""
+
+def plan(
+    distance: float,
+    *,
+    max_velocity: float,
+    max_acceleration: float,
+    max_jerk: Optional[float] = None,
+    max_snap: Optional[float] = None,
+    ts: float = ...,
+    lsb: float = ...,
+) -> Trajectory:
+    """A rest-to-rest move of `distance` units: order 4 with max_snap, 3 with max_jerk, else 2."""
+
+def plan_duration(
+    distance: float,
+    *,
+    duration: float,
+    gamma: float,
+    phi: float,
+    ts: float = ...,
+    lsb: float = ...,
+) -> Trajectory:
+    """Seed 001's duration-based S-curve: `distance` in `duration` s, gamma and phi in (0, 0.5]."""

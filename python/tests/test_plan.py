@@ -1,0 +1,149 @@
+"""The Python package's planners, checked from outside: every program is integrated here tick
+by tick in Python's exact integers (seed 000's eqs 72-75: j += d, a += j, v += a, x += v, each
+from the previous tick's values), independently of the Rust closed form the package uses, and
+the trajectory, its end and its limits are compared with that integration."""
+
+import math
+import random
+
+import numpy as np
+import pytest
+
+import snapgen
+
+
+def integrate(traj):
+    """Every tick's (x, v, a, j) from the start registers and the program, in Python ints."""
+    x, v, a, j = traj.start_registers
+    states = [(x, v, a, j)]
+    for ticks, snap in traj.program:
+        for _ in range(ticks):
+            x, v, a, j = x + v, v + a, a + j, j + snap
+            states.append((x, v, a, j))
+    return states
+
+
+def check_move(traj, distance, lsb, limits):
+    states = integrate(traj)
+    assert len(states) == traj.ticks + 1
+    # The package's registers at every tick are the independent integration's.
+    for k in range(0, traj.ticks + 1, max(1, traj.ticks // 200)):
+        assert traj.registers_at(k) == states[k], k
+    assert traj.registers_at(traj.ticks) == states[-1]
+    # Ends at rest, exactly on the asked distance's LSB grid point.
+    x0 = states[0][0]
+    x, v, a, j = states[-1]
+    assert (v, a, j) == (0, 0, 0)
+    moved = (x - x0) / traj.scale("position")
+    assert abs(moved - distance) <= lsb / 2 * (1 + 1e-9), (moved, distance)
+    assert abs(traj.target_position - moved) <= lsb * 1e-6
+    # Within every limit on every tick.
+    names = ["velocity", "acceleration", "jerk"]
+    for i, name in enumerate(names, start=1):
+        if name in limits:
+            peak = max(abs(s[i]) for s in states) / traj.scale(name)
+            assert peak <= limits[name] * (1 + 1e-12), (name, peak, limits[name])
+    if "snap" in limits:
+        peak = max(abs(d) for _, d in traj.program) / traj.scale("snap")
+        assert peak <= limits["snap"] * (1 + 1e-12)
+    return states
+
+
+def test_an_order_3_move_is_exact_and_within_its_limits():
+    lim = {"velocity": 0.5, "acceleration": 2.0, "jerk": 50.0}
+    t = snapgen.plan(0.1, max_velocity=0.5, max_acceleration=2.0, max_jerk=50.0, ts=1e-4)
+    assert t.order == 3
+    assert t.duration == pytest.approx(t.ticks * 1e-4)
+    check_move(t, 0.1, snapgen.DEFAULT_LSB, lim)
+
+
+def test_orders_4_and_2_and_negative_distances():
+    t4 = snapgen.plan(-0.05, max_velocity=0.3, max_acceleration=3.0, max_jerk=100.0,
+                      max_snap=5000.0, ts=2e-4)
+    assert t4.order == 4
+    check_move(t4, -0.05, snapgen.DEFAULT_LSB,
+               {"velocity": 0.3, "acceleration": 3.0, "jerk": 100.0, "snap": 5000.0})
+    t2 = snapgen.plan(0.2, max_velocity=0.4, max_acceleration=1.0, ts=1e-3, lsb=1e-5)
+    assert t2.order == 2
+    check_move(t2, 0.2, 1e-5, {"velocity": 0.4, "acceleration": 1.0})
+
+
+def test_seed_001s_duration_method():
+    # Seed 001's Table 1: 12*pi rad in 1.8 s, gamma = 0.3, phi = 0.3 (ts 1 ms here).
+    d = 12 * math.pi
+    t = snapgen.plan_duration(d, duration=1.8, gamma=0.3, phi=0.3, ts=1e-3, lsb=1e-4)
+    assert t.order == 3
+    check_move(t, d, 1e-4, {})
+    # The duration asked, up to the tick grid and the quantizer's cruise ticks.
+    assert 1.8 <= t.duration <= 1.8 + 0.01
+
+
+def test_random_moves_over_wide_ranges():
+    rng = random.Random(20261127)
+    for _ in range(12):
+        order = rng.choice([2, 3, 4])
+        ts = rng.choice([1e-4, 2e-4, 5e-4, 1e-3])
+        distance = rng.choice([-1, 1]) * 10 ** rng.uniform(-3, 0)
+        vmax = 10 ** rng.uniform(-1.5, 0.5)
+        amax = 10 ** rng.uniform(-0.5, 1.5)
+        jmax = 10 ** rng.uniform(1, 3)
+        smax = 10 ** rng.uniform(3, 5)
+        lim = {"velocity": vmax, "acceleration": amax}
+        kw = {}
+        if order >= 3:
+            kw["max_jerk"] = jmax
+            lim["jerk"] = jmax
+        if order == 4:
+            kw["max_snap"] = smax
+            lim["snap"] = smax
+        t = snapgen.plan(distance, max_velocity=vmax, max_acceleration=amax, ts=ts, **kw)
+        if t.ticks > 60000:
+            continue  # a long move: the per-tick Python integration would be slow
+        assert t.order == order
+        check_move(t, distance, snapgen.DEFAULT_LSB, lim)
+
+
+def test_at_time_and_at_times_sample_the_integrated_chain():
+    t = snapgen.plan(0.02, max_velocity=0.2, max_acceleration=2.0, max_jerk=80.0, ts=1e-3)
+    states = integrate(t)
+    sx, sv, sa, sj = (t.scale(q) for q in ("position", "velocity", "acceleration", "jerk"))
+    x0 = states[0][0]
+    times = np.array([-1.0, 0.0, 0.0005, 0.0123, t.duration / 2, t.duration - 1e-9,
+                      t.duration, t.duration + 5.0])
+    p, v, a, j = t.at_times(times)
+    assert p.shape == v.shape == a.shape == j.shape == times.shape
+    for i, time in enumerate(times):
+        k = min(max(math.floor(time / t.ts), 0), t.ticks)
+        x, vv, aa, jj = states[k]
+        want = ((x - x0) / sx, vv / sv, aa / sa, jj / sj)
+        assert t.at_time(float(time)) == pytest.approx(want, rel=1e-12, abs=1e-15)
+        assert (p[i], v[i], a[i], j[i]) == pytest.approx(want, rel=1e-12, abs=1e-15)
+
+
+def test_peaks_are_the_integrations_peaks():
+    t = snapgen.plan(0.1, max_velocity=0.5, max_acceleration=2.0, max_jerk=50.0, ts=1e-3)
+    states = integrate(t)
+    peaks = t.peaks()
+    for i, name in enumerate(["velocity", "acceleration", "jerk"], start=1):
+        want = max(abs(s[i]) for s in states) / t.scale(name)
+        assert peaks[name] == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(max_velocity=-1.0, max_acceleration=1.0, max_jerk=10.0), "vmax"),
+        (dict(max_velocity=1.0, max_acceleration=float("nan"), max_jerk=10.0), "amax"),
+        (dict(max_velocity=1.0, max_acceleration=1.0, max_snap=10.0), "max_snap without max_jerk"),
+        (dict(max_velocity=1.0, max_acceleration=1.0, ts=0.0), "ts = 0"),
+    ],
+)
+def test_bad_input_raises_plan_error_with_what_to_change(kwargs, message):
+    with pytest.raises(snapgen.PlanError, match=message) as e:
+        snapgen.plan(0.1, **kwargs)
+    assert isinstance(e.value, ValueError)
+
+
+def test_a_bad_ratio_names_the_range():
+    with pytest.raises(snapgen.PlanError, match="gamma"):
+        snapgen.plan_duration(1.0, duration=1.0, gamma=0.7, phi=0.3)
