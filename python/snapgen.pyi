@@ -13,6 +13,8 @@ DEFAULT_TS: float
 """The tick period the board runs after reset (s)."""
 DEFAULT_LSB: float
 """The default size of one output position LSB (units)."""
+FRAC_BITS: int
+"""Fractional bits of the position register: its output cell is x >> FRAC_BITS."""
 
 class PlanError(ValueError):
     """A move that cannot be planned; the message says what to change."""
@@ -38,6 +40,9 @@ class Trajectory:
     @property
     def program(self) -> List[Tuple[int, int]]:
         """(ticks, raw snap) per segment, as the fabric plays them."""
+    @property
+    def start_position(self) -> float:
+        """Where the move starts (absolute units, from the centre of output cell 0)."""
     @property
     def start_registers(self) -> Tuple[int, int, int, int]:
         """The chain's raw (x, v, a, j) before the move."""
@@ -81,3 +86,18 @@ def plan_duration(
     lsb: float = ...,
 ) -> Trajectory:
     """Seed 001's duration-based S-curve: `distance` in `duration` s, gamma and phi in (0, 0.5]."""
+
+def replan(
+    registers: Tuple[int, int, int, int],
+    *,
+    max_velocity: float,
+    max_acceleration: float,
+    max_deceleration: Optional[float] = None,
+    max_jerk: Optional[float] = None,
+    target_position: Optional[float] = None,
+    target_velocity: float = 0.0,
+    ts: float = ...,
+    lsb: float = ...,
+) -> Trajectory:
+    """Online from raw registers (x, v, a, j) to target_position (absolute units; passed at
+    target_velocity) or, without one, to holding target_velocity: order 3 with max_jerk, else 2."""

@@ -1,7 +1,8 @@
 //! `snapgen` for Python: the host's rest-to-rest planners (seed 000's order 4, orders 3 and 2,
-//! seed 001's duration method) with the exact program the fabric plays, its per-tick registers
-//! as Python integers, and the trajectory sampled at times (one time, or a NumPy array of them)
-//! in physical units. Names follow Ruckig's where the concepts match (`max_velocity`,
+//! seed 001's duration method) and its online planner (seed 002: from any exact chain state to
+//! a position or a velocity, orders 3 and 2), with the exact program the fabric plays, its
+//! per-tick registers as Python integers, and the trajectory sampled at times (one time, or a
+//! NumPy array of them) in physical units. Names follow Ruckig's where the concepts match (`max_velocity`,
 //! `duration`, `at_time`, `at_times`); a move that cannot be planned raises
 //! `snapgen.PlanError` (a `ValueError`) with the planner's own message. No I/O: boards are
 //! driven by the `snapgen` command-line tool.
@@ -16,8 +17,11 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use snapgen_model::chain::ChainState;
-use snapgen_model::format::{Format, Quantity, DEFAULT_FORMAT};
-use snapgen_plan::{Method, MoveRequest, Plan};
+use snapgen_model::format::{Format, Quantity, DEFAULT_FORMAT, FRAC_BITS};
+use snapgen_model::peaks::Peaks;
+use snapgen_model::program::Program;
+use snapgen_plan::online::{plan_online, OnlineLimits, OnlineOrder, OnlineTarget};
+use snapgen_plan::{Method, MoveRequest};
 
 create_exception!(
     snapgen,
@@ -26,10 +30,29 @@ create_exception!(
     "A move that cannot be planned (an input not finite or not positive, a ratio out of range, a move the format cannot hold); the message says what to change."
 );
 
-/// A planned move: the program the fabric plays and the trajectory it makes.
+/// A planned move: the program the fabric plays from its start state and the trajectory it
+/// makes.
 #[pyclass(module = "snapgen", frozen)]
 struct Trajectory {
-    plan: Plan,
+    format: Format,
+    start: ChainState,
+    program: Program,
+    order: u8,
+    /// Exact peaks of every register over the program.
+    peaks: Peaks,
+}
+
+impl Trajectory {
+    fn new(format: Format, start: ChainState, program: Program, order: u8) -> Self {
+        let (peaks, _) = snapgen_model::peaks::peaks(&program, &start);
+        Trajectory {
+            format,
+            start,
+            program,
+            order,
+            peaks,
+        }
+    }
 }
 
 /// The format for a tick period and an output LSB, both checked.
@@ -50,7 +73,13 @@ fn format(ts: f64, lsb: f64) -> PyResult<Format> {
 
 fn planned(request: MoveRequest, f: &Format) -> PyResult<Trajectory> {
     snapgen_plan::plan(&request, f)
-        .map(|plan| Trajectory { plan })
+        .map(|p| Trajectory {
+            format: *f,
+            start: p.start,
+            order: p.order(),
+            peaks: p.peaks,
+            program: p.program,
+        })
         .map_err(|e| PlanError::new_err(e.to_string()))
 }
 
@@ -113,14 +142,66 @@ fn plan_duration(
     planned(MoveRequest { distance, method }, &format(ts, lsb)?)
 }
 
+/// Plans online from any exact chain state (seed 002; PLCopen MC_MoveAbsolute and
+/// MC_MoveVelocity): from `registers`, the raw `(x, v, a, j)` a trajectory's `registers_at`
+/// gives, to rest at `target_position` (absolute units: cell `round(target_position / lsb)`),
+/// passing it at `target_velocity` (units/s) when that is not 0 — or, without a
+/// `target_position`, to holding `target_velocity`. Order 3 with `max_jerk`, else 2;
+/// `max_acceleration` applies while |v| grows, `max_deceleration` (default: the acceleration)
+/// while it shrinks. The end is exact: at rest in the target's cell, or at the target
+/// velocity's raw value with a = j = 0.
+#[pyfunction]
+#[pyo3(signature = (registers, *, max_velocity, max_acceleration, max_deceleration=None, max_jerk=None, target_position=None, target_velocity=0.0, ts=DEFAULT_FORMAT.ts, lsb=DEFAULT_FORMAT.position_lsb))]
+#[allow(clippy::too_many_arguments)]
+fn replan(
+    registers: (i128, i128, i128, i128),
+    max_velocity: f64,
+    max_acceleration: f64,
+    max_deceleration: Option<f64>,
+    max_jerk: Option<f64>,
+    target_position: Option<f64>,
+    target_velocity: f64,
+    ts: f64,
+    lsb: f64,
+) -> PyResult<Trajectory> {
+    let f = format(ts, lsb)?;
+    let (x, v, a, j) = registers;
+    let start = ChainState { x, v, a, j };
+    let target = match target_position {
+        Some(p) if !p.is_finite() => {
+            return Err(PlanError::new_err(format!(
+                "target_position = {p}: give a finite position (units)"
+            )))
+        }
+        Some(p) => OnlineTarget::Position {
+            cell: snapgen_plan::planner::fmath::round(p / lsb) as i128,
+            velocity: target_velocity,
+        },
+        None => OnlineTarget::Velocity(target_velocity),
+    };
+    let (order, jerk) = match max_jerk {
+        Some(j) => (OnlineOrder::Three, j),
+        None => (OnlineOrder::Two, f64::INFINITY),
+    };
+    let limits = OnlineLimits {
+        velocity: max_velocity,
+        acceleration: max_acceleration,
+        deceleration: max_deceleration.unwrap_or(max_acceleration),
+        jerk,
+    };
+    let p = plan_online(&start, &target, &limits, order, &f)
+        .map_err(|e| PlanError::new_err(e.to_string()))?;
+    Ok(Trajectory::new(f, p.start, p.program, order.number()))
+}
+
 impl Trajectory {
     /// The tick a time falls in, clamped to the move.
     fn tick_at(&self, t: f64) -> u64 {
-        let ticks = self.plan.ticks_total();
+        let ticks = self.program.total_ticks();
         if t.is_nan() || t <= 0.0 {
             return 0;
         }
-        let k = (t / self.plan.format.ts).floor();
+        let k = (t / self.format.ts).floor();
         if k >= ticks as f64 {
             ticks
         } else {
@@ -129,16 +210,15 @@ impl Trajectory {
     }
 
     fn state_after(&self, k: u64) -> ChainState {
-        self.plan
-            .start
-            .after_ticks(&self.plan.program, k, &self.plan.format.widths)
+        self.start
+            .after_ticks(&self.program, k, &self.format.widths)
     }
 
     /// Position (from the start), velocity, acceleration and jerk, physical.
     fn physical(&self, s: &ChainState) -> (f64, f64, f64, f64) {
-        let f = &self.plan.format;
+        let f = &self.format;
         (
-            f.position_physical(s.x) - f.position_physical(self.plan.start.x),
+            f.position_physical(s.x) - f.position_physical(self.start.x),
             f.to_physical(Quantity::Velocity, s.v),
             f.to_physical(Quantity::Acceleration, s.a),
             f.to_physical(Quantity::Jerk, s.j),
@@ -151,39 +231,47 @@ impl Trajectory {
     /// The move's duration in seconds (its ticks times ts).
     #[getter]
     fn duration(&self) -> f64 {
-        self.plan.duration_s()
+        self.program.total_ticks() as f64 * self.format.ts
     }
 
     /// The move's length in ticks.
     #[getter]
     fn ticks(&self) -> u64 {
-        self.plan.ticks_total()
+        self.program.total_ticks()
     }
 
     /// The tick period (s).
     #[getter]
     fn ts(&self) -> f64 {
-        self.plan.format.ts
+        self.format.ts
     }
 
     /// The profile's order: 4 (snap-limited), 3 (jerk-limited) or 2 (acceleration-limited).
     #[getter]
     fn order(&self) -> u8 {
-        self.plan.order()
+        self.order
     }
 
-    /// The distance the move ends at, in units: the asked one on the output LSB grid.
+    /// Where the move ends, in units from its start (a rest-to-rest move: the asked distance
+    /// on the output LSB grid).
     #[getter]
     fn target_position(&self) -> f64 {
-        self.plan.target_physical()
+        let end = self.state_after(self.program.total_ticks());
+        self.physical(&end).0
+    }
+
+    /// Where the move starts, in absolute units (from the centre of output cell 0): add it to
+    /// `at_time`'s positions for absolute ones.
+    #[getter]
+    fn start_position(&self) -> f64 {
+        self.format.position_physical(self.start.x)
     }
 
     /// The program the fabric plays: `(ticks, snap)` per segment, the snap as the raw integer
     /// fed to the chain on each of those ticks.
     #[getter]
     fn program(&self) -> Vec<(u32, i128)> {
-        self.plan
-            .program
+        self.program
             .segments
             .iter()
             .map(|s| (s.ticks, s.snap))
@@ -193,14 +281,14 @@ impl Trajectory {
     /// The chain's registers `(x, v, a, j)` before the move, raw (exact integers).
     #[getter]
     fn start_registers(&self) -> (i128, i128, i128, i128) {
-        let s = self.plan.start;
+        let s = self.start;
         (s.x, s.v, s.a, s.j)
     }
 
     /// The chain's registers `(x, v, a, j)` after `tick` ticks, raw (exact integers, as the
     /// fabric holds them); past the end, the final state.
     fn registers_at(&self, tick: u64) -> (i128, i128, i128, i128) {
-        let s = self.state_after(tick.min(self.plan.ticks_total()));
+        let s = self.state_after(tick.min(self.program.total_ticks()));
         (s.x, s.v, s.a, s.j)
     }
 
@@ -219,7 +307,7 @@ impl Trajectory {
                 )))
             }
         };
-        Ok(self.plan.format.scale(q))
+        Ok(self.format.scale(q))
     }
 
     /// Position (units from the start), velocity, acceleration and jerk at time `t` (s): the
@@ -274,17 +362,25 @@ impl Trajectory {
             ("snap", Quantity::Snap),
         ]
         .into_iter()
-        .map(|(name, q)| (name, self.plan.peak_physical(q)))
+        .map(|(name, q)| {
+            let raw = match q {
+                Quantity::Velocity => self.peaks.v,
+                Quantity::Acceleration => self.peaks.a,
+                Quantity::Jerk => self.peaks.j,
+                _ => self.peaks.d,
+            };
+            (name, raw.as_f64() / self.format.scale(q))
+        })
         .collect()
     }
 
     fn __repr__(&self) -> String {
         format!(
             "Trajectory(order={}, duration={:.6} s, ticks={}, target_position={})",
-            self.plan.order(),
-            self.plan.duration_s(),
-            self.plan.ticks_total(),
-            self.plan.target_physical()
+            self.order,
+            self.duration(),
+            self.ticks(),
+            self.target_position()
         )
     }
 }
@@ -295,8 +391,10 @@ fn snapgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(replan, m)?)?;
     m.add("PlanError", m.py().get_type::<PlanError>())?;
     m.add("DEFAULT_TS", DEFAULT_FORMAT.ts)?;
     m.add("DEFAULT_LSB", DEFAULT_FORMAT.position_lsb)?;
+    m.add("FRAC_BITS", FRAC_BITS)?;
     Ok(())
 }

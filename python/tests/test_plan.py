@@ -147,3 +147,46 @@ def test_bad_input_raises_plan_error_with_what_to_change(kwargs, message):
 def test_a_bad_ratio_names_the_range():
     with pytest.raises(snapgen.PlanError, match="gamma"):
         snapgen.plan_duration(1.0, duration=1.0, gamma=0.7, phi=0.3)
+
+
+def test_replanning_from_a_moving_state_ends_exactly_on_the_new_target():
+    """Seed 002 / MC_MoveAbsolute aborting a move: from the exact registers halfway through a
+    move, a new target behind it; the new program, integrated here from those registers,
+    reverses within its limits and comes to rest in the target's cell."""
+    lim = dict(max_velocity=0.5, max_acceleration=2.0, max_jerk=50.0)
+    first = snapgen.plan(0.1, ts=1e-4, **lim)
+    mid = first.registers_at(first.ticks // 2)
+    assert mid[1] != 0  # moving
+    lsb = snapgen.DEFAULT_LSB
+    for order_kw, order in ((dict(max_jerk=50.0), 3), ({}, 2)):
+        t = snapgen.replan(mid, max_velocity=0.5, max_acceleration=2.0, max_deceleration=3.0,
+                           target_position=0.01, ts=1e-4, **order_kw)
+        assert t.order == order
+        assert t.start_registers == mid
+        states = integrate(t)
+        x, v, a, j = states[-1]
+        assert (v, a, j) == (0, 0, 0)
+        assert x >> snapgen.FRAC_BITS == round(0.01 / lsb)
+        assert t.start_position + t.target_position == pytest.approx(0.01, abs=lsb)
+        assert max(abs(s[1]) for s in states) / t.scale("velocity") <= 0.5 * (1 + 1e-12)
+        assert max(abs(s[2]) for s in states) / t.scale("acceleration") <= 3.0 * (1 + 1e-12)
+        if order == 3:
+            assert max(abs(s[3]) for s in states) / t.scale("jerk") <= 50.0 * (1 + 1e-12)
+
+
+def test_replanning_to_a_velocity_holds_it():
+    t = snapgen.plan(0.1, max_velocity=0.5, max_acceleration=2.0, max_jerk=50.0, ts=1e-4)
+    mid = t.registers_at(t.ticks // 3)
+    r = snapgen.replan(mid, max_velocity=0.5, max_acceleration=2.0, max_jerk=50.0,
+                       target_velocity=-0.2, ts=1e-4)
+    x, v, a, j = integrate(r)[-1]
+    assert (a, j) == (0, 0)
+    assert abs(v / r.scale("velocity") + 0.2) <= 1 / r.scale("velocity")
+
+
+def test_replanning_refuses_what_cannot_be_done():
+    with pytest.raises(snapgen.PlanError, match="beyond the velocity limit"):
+        snapgen.replan((0, 0, 0, 0), max_velocity=0.5, max_acceleration=2.0, target_velocity=1.0)
+    with pytest.raises(snapgen.PlanError, match="target_position = inf"):
+        snapgen.replan((0, 0, 0, 0), max_velocity=0.5, max_acceleration=2.0,
+                       target_position=float("inf"))
