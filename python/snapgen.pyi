@@ -101,3 +101,61 @@ def replan(
 ) -> Trajectory:
     """Online from raw registers (x, v, a, j) to target_position (absolute units; passed at
     target_velocity) or, without one, to holding target_velocity: order 3 with max_jerk, else 2."""
+
+class BoardError(RuntimeError):
+    """The link or the board failed (no reply, a NAK, an axis error, a wrong end)."""
+
+class MoveReport:
+    """The outcome of Board.move_by."""
+
+    trajectory: Trajectory
+    """The move as planned from the board's registers with its Ts and uploaded."""
+    end_registers: Tuple[int, int, int, int]
+    """The board's raw (x, v, a, j) after it."""
+    ticks: int
+    """The board's tick count at its end."""
+    stopped: bool
+    """Cut short by a controlled stop (stop_after)."""
+    warnings: List[str]
+    """What the host warned about (stop limits)."""
+
+class Board:
+    """A board behind the host's session: virtual (time in its own clocks) or on a serial port."""
+
+    @staticmethod
+    def model(*, baud: int = 115200, lsb: float = ...) -> "Board":
+        """The device model (the I/O top's clock-accurate twin) as a virtual board."""
+    @staticmethod
+    def fabric(*, baud: int = 115200, lsb: float = ...) -> "Board":
+        """The Verilated I/O top as a virtual board (needs Verilator and a C++ compiler)."""
+    @staticmethod
+    def serial(port: str, *, baud: int = 115200, lsb: float = ...) -> "Board":
+        """A real board on a serial port."""
+    @property
+    def ts(self) -> float:
+        """The board's tick period (s), read from it."""
+    @property
+    def clock_hz(self) -> int:
+        """The board's fabric clock (Hz)."""
+    @property
+    def time(self) -> float:
+        """The link's clock (s): a virtual board's own time, or the wall clock."""
+    def state(self) -> Tuple[int, int, int, int, int]:
+        """(ticks, x, v, a, j), raw."""
+    def stop(self) -> None:
+        """A controlled stop (STOP)."""
+    def move_by(
+        self,
+        distance: float,
+        *,
+        max_velocity: float,
+        max_acceleration: float,
+        max_jerk: Optional[float] = None,
+        max_snap: Optional[float] = None,
+        stop_decel: Optional[float] = None,
+        stop_jerk: Optional[float] = None,
+        stop_after: Optional[float] = None,
+        watchdog_ms: int = 1000,
+        reset: bool = False,
+    ) -> MoveReport:
+        """Moves `distance` units as `snapgen send` does; the end is checked bit for bit."""

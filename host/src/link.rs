@@ -98,24 +98,30 @@ pub trait Transport {
     fn byte_time(&self) -> f64;
 }
 
-/// A medium borrowed is a medium (a session over a simulation the caller keeps).
-impl<T: Transport + ?Sized> Transport for &mut T {
-    fn write(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        (**self).write(bytes)
-    }
-    fn read(&mut self, wait: f64, out: &mut Vec<u8>) -> Result<(), LinkError> {
-        (**self).read(wait, out)
-    }
-    fn now(&self) -> f64 {
-        (**self).now()
-    }
-    fn sleep(&mut self, seconds: f64) {
-        (**self).sleep(seconds)
-    }
-    fn byte_time(&self) -> f64 {
-        (**self).byte_time()
-    }
+/// A medium behind a pointer is the medium: `&mut T` (a session over a simulation the caller
+/// keeps) and `Box<T>` (a host that picks its board at run time).
+macro_rules! forward_transport {
+    ($($ptr:ty),*) => {$(
+        impl<T: Transport + ?Sized> Transport for $ptr {
+            fn write(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+                (**self).write(bytes)
+            }
+            fn read(&mut self, wait: f64, out: &mut Vec<u8>) -> Result<(), LinkError> {
+                (**self).read(wait, out)
+            }
+            fn now(&self) -> f64 {
+                (**self).now()
+            }
+            fn sleep(&mut self, seconds: f64) {
+                (**self).sleep(seconds)
+            }
+            fn byte_time(&self) -> f64 {
+                (**self).byte_time()
+            }
+        }
+    )*};
 }
+forward_transport!(&mut T, Box<T>);
 
 /// A short name for messages: `LOAD_SEGMENT 3`, `CONFIGURE STOP_JERK 5`, `START`, …
 pub fn command_name(c: &Command) -> String {

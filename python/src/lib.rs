@@ -4,12 +4,15 @@
 //! per-tick registers as Python integers, and the trajectory sampled at times (one time, or a
 //! NumPy array of them) in physical units. Names follow Ruckig's where the concepts match (`max_velocity`,
 //! `duration`, `at_time`, `at_times`); a move that cannot be planned raises
-//! `snapgen.PlanError` (a `ValueError`) with the planner's own message. No I/O: boards are
-//! driven by the `snapgen` command-line tool.
+//! `snapgen.PlanError` (a `ValueError`) with the planner's own message. [`board`]: a board
+//! (virtual or on a serial port) behind the host's session, moves run as `snapgen send` runs
+//! them; its failures raise `snapgen.BoardError` (a `RuntimeError`).
 //!
 //! Time: the fabric's output changes once per tick and holds between ticks, so the state at
 //! time `t` is the state after `floor(t / ts)` ticks, clamped to the move (`t < 0` gives the
 //! start, `t` past the end the final state at rest).
+
+mod board;
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -33,7 +36,7 @@ create_exception!(
 /// A planned move: the program the fabric plays from its start state and the trajectory it
 /// makes.
 #[pyclass(module = "snapgen", frozen)]
-struct Trajectory {
+pub struct Trajectory {
     format: Format,
     start: ChainState,
     program: Program,
@@ -43,7 +46,7 @@ struct Trajectory {
 }
 
 impl Trajectory {
-    fn new(format: Format, start: ChainState, program: Program, order: u8) -> Self {
+    pub(crate) fn new(format: Format, start: ChainState, program: Program, order: u8) -> Self {
         let (peaks, _) = snapgen_model::peaks::peaks(&program, &start);
         Trajectory {
             format,
@@ -99,7 +102,19 @@ fn plan(
     ts: f64,
     lsb: f64,
 ) -> PyResult<Trajectory> {
-    let method = match (max_jerk, max_snap) {
+    let method = method(max_velocity, max_acceleration, max_jerk, max_snap)?;
+    planned(MoveRequest { distance, method }, &format(ts, lsb)?)
+}
+
+/// The method the limits given select: order 4 with `max_snap` (and `max_jerk`), 3 with
+/// `max_jerk`, else 2.
+fn method(
+    max_velocity: f64,
+    max_acceleration: f64,
+    max_jerk: Option<f64>,
+    max_snap: Option<f64>,
+) -> PyResult<Method> {
+    Ok(match (max_jerk, max_snap) {
         (Some(jmax), Some(dmax)) => Method::Order4 {
             vmax: max_velocity,
             amax: max_acceleration,
@@ -118,8 +133,7 @@ fn plan(
         (None, Some(_)) => return Err(PlanError::new_err(
             "max_snap without max_jerk: an order-4 move needs both (or drop max_snap for order 2)",
         )),
-    };
-    planned(MoveRequest { distance, method }, &format(ts, lsb)?)
+    })
 }
 
 /// Plans seed 001's duration-based S-curve: `distance` units in `duration` seconds, the
@@ -389,6 +403,9 @@ impl Trajectory {
 #[pymodule]
 fn snapgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
+    m.add_class::<board::Board>()?;
+    m.add_class::<board::MoveReport>()?;
+    m.add("BoardError", m.py().get_type::<board::BoardError>())?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan_duration, m)?)?;
     m.add_function(wrap_pyfunction!(replan, m)?)?;
