@@ -1,7 +1,10 @@
-"""snapgen's planners: rest-to-rest moves, exact on the integer chain of the snapgen FPGA core.
+"""snapgen: moves exact on the integer chain of the snapgen FPGA core.
 
-The state at time t is the state after floor(t / ts) ticks, clamped to the move (the fabric's
-output holds between ticks). Positions are in units from the start, velocities in units/s, ...
+plan / plan_duration: rest-to-rest moves; replan: seed 002's online planner from any exact
+state; Board: a board (virtual or on a serial port) that runs moves as `snapgen send` does.
+The state at time t is the state after the last tick k with k * ts <= t, clamped to the move
+(the fabric's output holds between ticks). Positions are in units from the start, velocities
+in units/s, ...
 """
 
 from typing import Dict, List, Optional, Tuple

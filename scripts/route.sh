@@ -65,4 +65,9 @@ route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generat
 route snapgen_core "the motion core: sequencer, chain, stop unit"
 # The board design (I/O top, motion core, the PLL, the pins) to a bitstream, at the ULX3S's
 # clock.
-./target/release/snapgen build --board ulx3s --out "$work/ulx3s" | tail -1
+if ! ./target/release/snapgen build --board ulx3s --out "$work/ulx3s" >"$work/ulx3s.out"; then
+  # (The build directory goes with $work: its logs' ends here.)
+  tail -5 "$work/ulx3s/nextpnr.log" "$work/ulx3s/yosys.log" >&2 2>/dev/null || true
+  exit 1
+fi
+tail -1 "$work/ulx3s.out"

@@ -125,6 +125,23 @@ pub struct Pin {
     pub comment: String,
 }
 
+/// A pin the board top drives to a constant level, for the board's own sake (e.g. the
+/// ULX3S's ESP32 GPIO0, held high so that the module does not reset the board).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tie {
+    /// Top-level port (a Verilog name).
+    pub port: String,
+    /// Package pin.
+    pub pin: String,
+    /// I/O standard.
+    pub iostandard: String,
+    /// The level driven: 0 or 1.
+    pub level: u8,
+    /// Why.
+    pub comment: String,
+}
+
 /// A board.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -154,6 +171,9 @@ pub struct Board {
     pub input_polarity: u8,
     /// Pins.
     pub pins: Vec<Pin>,
+    /// Pins driven to a constant level (optional).
+    #[serde(default)]
+    pub ties: Vec<Tie>,
 }
 
 /// A board description that cannot be used, with what to change.
@@ -426,6 +446,33 @@ impl Board {
                 return Err(bad(&field, &p.port, "each port once"));
             }
         }
+        for t in &self.ties {
+            let field = format!("ties[{}]", t.port);
+            claim(&t.pin, &t.iostandard, &field)?;
+            if !is_identifier(&t.port) {
+                return Err(bad(&field, &t.port, "a tied port is a Verilog name"));
+            }
+            if t.level > 1 {
+                return Err(bad(&format!("{field}.level"), &t.level, "give 0 or 1"));
+            }
+            if let Some(other) = pins.insert(&t.pin, &t.port) {
+                return Err(bad(
+                    &format!("{field}.pin"),
+                    &t.pin,
+                    &format!("pin {} is already used by {other}: each pin once", t.pin),
+                ));
+            }
+            if ports.contains_key(t.port.as_str())
+                || top_ports().iter().any(|(p, _, _)| p == &t.port)
+                || self.ties.iter().filter(|u| u.port == t.port).count() > 1
+            {
+                return Err(bad(
+                    &field,
+                    &t.port,
+                    "each port once, and not a port of the board top's",
+                ));
+            }
+        }
         let top = top_ports();
         for (port, dir, what) in &top {
             let (port, dir) = (port.as_str(), *dir);
@@ -542,7 +589,12 @@ mod tests {
             (25_000_000, 75_000_000)
         );
         let ulx3s = BUILTIN[1].1;
-        let cases: [(String, &str); 4] = [
+        let cases: [(String, &str); 6] = [
+            (ulx3s.replace("level = 1", "level = 2"), "give 0 or 1"),
+            (
+                ulx3s.replace("port = \"wifi_gpio0\"", "port = \"pwm\""),
+                "not a port of the board top",
+            ),
             (
                 ulx3s.replace("device = \"LFE5U-85F\"", "device = \"LFE5U-100F\""),
                 "give an ECP5 device nextpnr-ecp5 knows",

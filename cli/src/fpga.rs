@@ -1,8 +1,10 @@
-//! The Vivado build plan and the Yosys synthesis check of a board ([`crate::board_spec`]).
+//! A board's build plan and the Yosys synthesis check of a board ([`crate::board_spec`]).
 //!
-//! * [`BuildPlan`] is data too: every file of a Vivado non-project build (board top Verilog,
-//!   the I/O top, XDC, TCL, Makefile) and the command that runs it; it can be written without
-//!   running anything. Running needs Vivado (`$VIVADO` or `vivado` on the PATH).
+//! * [`BuildPlan`] is data too: every file of the build (board top Verilog, the I/O top and
+//!   the toolchain's files) and how it runs; it can be written without running anything. A
+//!   Xilinx board's is a Vivado non-project build (XDC, TCL, Makefile; running needs Vivado,
+//!   `$VIVADO` or `vivado` on the PATH); an ECP5 board's is the open flow of [`crate::ecp5`]
+//!   (LPF, Makefile), run here.
 //! * [`synth`] runs Yosys `synth_xilinx -family xc7` on the full top and on the motion core alone,
 //!   reads the cell counts, and estimates the logic-only critical path with Yosys `sta` (the
 //!   Xilinx cell library with its specify blocks; routing delay is not included).
@@ -56,6 +58,14 @@ pub fn board_top_verilog(
             None => ports.push((base.to_string(), p.dir, bit.map_or(1, |k| k + 1), vec![doc])),
         }
     }
+    for t in &b.ties {
+        ports.push((t.port.clone(), Dir::Out, 1, vec![t.comment.clone()]));
+    }
+    let ties: String = b
+        .ties
+        .iter()
+        .map(|t| format!("    assign {} = 1'b{};\n", t.port, t.level))
+        .collect();
     let decls: Vec<String> = ports
         .iter()
         .enumerate()
@@ -80,7 +90,7 @@ pub fn board_top_verilog(
     let (clock, clock_gen, unlocked) = match &pll {
         Some((fin, fout, s)) => (
             "clk",
-            crate::ecp5::pll_verilog(BOARD_CLOCK, *fin, *fout, s) + "\n",
+            crate::ecp5::pll::pll_verilog(BOARD_CLOCK, *fin, *fout, s) + "\n",
             " | !pll_locked",
         ),
         None => (BOARD_CLOCK, String::new(), ""),
@@ -114,7 +124,7 @@ pub fn board_top_verilog(
 module {top} (
 {decls}
 );
-{clock_gen}    // Reset: held for 16 clocks after configuration, and while the button is pressed{lock_doc}
+{clock_gen}{ties_block}    // Reset: held for 16 clocks after configuration, and while the button is pressed{lock_doc}
     // (synchronised through two flip-flops).
     reg [1:0] btn_sync = 2'b00;
     reg [4:0] por_count = 5'd0;
@@ -144,6 +154,11 @@ endmodule
             ""
         },
         button = BOARD_RESET,
+        ties_block = if ties.is_empty() {
+            String::new()
+        } else {
+            format!("    // Pins held at a level for the board's sake (its board file's [[ties]]).\n{ties}\n")
+        },
         conns = conns.join(",\n        "),
     )
 }
@@ -178,6 +193,12 @@ pub fn xdc(b: &Board, timing: &Timing) -> String {
         s.push_str(&format!(
             "set_property PULLTYPE {pull} [get_ports {{ {} }}]\n",
             p.port
+        ));
+    }
+    for t in &b.ties {
+        s.push_str(&format!(
+            "set_property -dict {{ PACKAGE_PIN {} IOSTANDARD {} }} [get_ports {{ {} }}] ;# {} (held at {})\n",
+            t.pin, t.iostandard, t.port, t.comment, t.level
         ));
     }
     s
@@ -523,10 +544,11 @@ impl BoardSynth {
 /// Synthesises the board top and the motion core alone (in a temporary directory).
 pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<BoardSynth> {
     if b.toolchain() == Toolchain::OpenEcp5 {
-        bail!(
-            "snapgen synth reports Yosys synth_xilinx for Xilinx boards; the {} is an ECP5 board: `snapgen build --board-file/--board` synthesises, places and routes it and prints its routed Fmax and resources",
+        return Err(crate::error::InputError::Board(format!(
+            "snapgen synth reports Yosys synth_xilinx for Xilinx boards; the {} is an ECP5 board: `snapgen build` synthesises, places and routes it and prints its routed Fmax and resources",
             b.name
-        );
+        ))
+        .into());
     }
     let dir = std::env::temp_dir().join(format!("snapgen-synth-{}", std::process::id()));
     let plan = build_plan(b, timing, design)?;

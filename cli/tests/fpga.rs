@@ -306,6 +306,7 @@ fn build_writes_an_open_ecp5_build() {
         ("led[3]", "D2"),
         ("pwm", "B11"),
         ("enc_i", "A7"),
+        ("wifi_gpio0", "L2"),
     ] {
         let line = format!("LOCATE COMP \"{port}\" SITE \"{site}\";");
         assert!(lpf.contains(&line), "missing {line}");
@@ -319,6 +320,7 @@ fn build_writes_an_open_ecp5_build() {
         ".CLKOP_DIV(8)",
         ".clock(clk)",
         "btn_reset | !pll_locked",
+        "assign wifi_gpio0 = 1'b1;",
         "Clock 75 MHz",
     ] {
         assert!(top.contains(want), "board top lacks {want}");
@@ -378,5 +380,23 @@ fn build_writes_an_open_ecp5_build() {
         err.contains("no ECP5 PLL setting makes exactly 77000000 Hz"),
         "{err}"
     );
+    // Flags of the other toolchain, and synth's Xilinx report, are refused (exit 2).
+    let out_dir = dir.to_str().unwrap();
+    for (args, want) in [
+        (
+            vec!["build", "--board", "ulx3s", "--run", "--out", out_dir],
+            "drop --run",
+        ),
+        (
+            vec!["build", "--files-only", "--out", out_dir],
+            "drop --files-only",
+        ),
+        (vec!["synth", "--board", "ulx3s"], "is an ECP5 board"),
+    ] {
+        let out = snapgen(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

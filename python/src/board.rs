@@ -171,6 +171,13 @@ impl Board {
         reset: bool,
     ) -> PyResult<MoveReport> {
         let method = crate::method(max_velocity, max_acceleration, max_jerk, max_snap)?;
+        if let Some(t) = stop_after {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(PlanError::new_err(format!(
+                    "stop_after = {t}: give the seconds after the start to send the stop (>= 0)"
+                )));
+            }
+        }
         let opts = SendOptions {
             ts: None,
             stop_decel,

@@ -9,8 +9,8 @@
 //! them; its failures raise `snapgen.BoardError` (a `RuntimeError`).
 //!
 //! Time: the fabric's output changes once per tick and holds between ticks, so the state at
-//! time `t` is the state after `floor(t / ts)` ticks, clamped to the move (`t < 0` gives the
-//! start, `t` past the end the final state at rest).
+//! time `t` is the state after the last tick `k` with `k · ts <= t`, clamped to the move
+//! (`t < 0` gives the start, `t` from `duration` on the final state at rest).
 
 mod board;
 
@@ -181,6 +181,15 @@ fn replan(
     let f = format(ts, lsb)?;
     let (x, v, a, j) = registers;
     let start = ChainState { x, v, a, j };
+    // Registers the board can hold: each within its width (what registers_at gives).
+    let w = f.widths;
+    for (name, value, bits) in [("x", x, w.x), ("v", v, w.v), ("a", a, w.a), ("j", j, w.j)] {
+        if snapgen_model::chain::wrap(value, bits) != value {
+            return Err(PlanError::new_err(format!(
+                "registers: {name} = {value} does not fit the board's {bits}-bit register: give the raw registers a trajectory's registers_at or a board's state returns"
+            )));
+        }
+    }
     let target = match target_position {
         Some(p) if !p.is_finite() => {
             return Err(PlanError::new_err(format!(
@@ -209,18 +218,29 @@ fn replan(
 }
 
 impl Trajectory {
-    /// The tick a time falls in, clamped to the move.
-    fn tick_at(&self, t: f64) -> u64 {
+    /// The tick a time falls in, clamped to the move: the last `k` with `k · ts <= t` (the
+    /// product in floating point, as `duration` is computed, so `at_time(duration)` is the
+    /// end; `t / ts` alone can round below a whole number of ticks).
+    fn tick_at(&self, t: f64) -> PyResult<u64> {
+        if t.is_nan() {
+            return Err(PyValueError::new_err("t is NaN: give a time in seconds"));
+        }
         let ticks = self.program.total_ticks();
-        if t.is_nan() || t <= 0.0 {
-            return 0;
+        let ts = self.format.ts;
+        if t <= 0.0 {
+            return Ok(0);
         }
-        let k = (t / self.format.ts).floor();
-        if k >= ticks as f64 {
-            ticks
-        } else {
-            k as u64
+        if t >= ticks as f64 * ts {
+            return Ok(ticks);
         }
+        let mut k = (t / ts).floor().clamp(0.0, ticks as f64) as u64;
+        while k < ticks && (k + 1) as f64 * ts <= t {
+            k += 1;
+        }
+        while k > 0 && k as f64 * ts > t {
+            k -= 1;
+        }
+        Ok(k)
     }
 
     fn state_after(&self, k: u64) -> ChainState {
@@ -325,9 +345,9 @@ impl Trajectory {
     }
 
     /// Position (units from the start), velocity, acceleration and jerk at time `t` (s): the
-    /// state after `floor(t / ts)` ticks, clamped to the move.
-    fn at_time(&self, t: f64) -> (f64, f64, f64, f64) {
-        self.physical(&self.state_after(self.tick_at(t)))
+    /// state after the last tick `k` with `k · ts <= t`, clamped to the move (NaN: an error).
+    fn at_time(&self, t: f64) -> PyResult<(f64, f64, f64, f64)> {
+        Ok(self.physical(&self.state_after(self.tick_at(t)?)))
     }
 
     /// [`at_time`] for every time of a NumPy array: four arrays (position, velocity,
@@ -352,7 +372,7 @@ impl Trajectory {
             Vec::with_capacity(n),
         );
         for &t in times.iter() {
-            let s = self.physical(&self.state_after(self.tick_at(t)));
+            let s = self.physical(&self.state_after(self.tick_at(t)?));
             p.push(s.0);
             v.push(s.1);
             a.push(s.2);

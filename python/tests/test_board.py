@@ -46,5 +46,7 @@ def test_bad_input_and_a_missing_port():
     b = snapgen.Board.model()
     with pytest.raises(snapgen.PlanError, match="vmax"):
         b.move_by(0.001, max_velocity=-1.0, max_acceleration=1.0)
+    with pytest.raises(snapgen.PlanError, match="stop_after = NaN"):
+        b.move_by(0.001, stop_after=float("nan"), **LIMITS)
     with pytest.raises(snapgen.BoardError):
         snapgen.Board.serial("/nonexistent/tty")

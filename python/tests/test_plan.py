@@ -113,11 +113,39 @@ def test_at_time_and_at_times_sample_the_integrated_chain():
     p, v, a, j = t.at_times(times)
     assert p.shape == v.shape == a.shape == j.shape == times.shape
     for i, time in enumerate(times):
-        k = min(max(math.floor(time / t.ts), 0), t.ticks)
-        x, vv, aa, jj = states[k]
+        x, vv, aa, jj = states[tick_at(t, time)]
         want = ((x - x0) / sx, vv / sv, aa / sa, jj / sj)
         assert t.at_time(float(time)) == pytest.approx(want, rel=1e-12, abs=1e-15)
         assert (p[i], v[i], a[i], j[i]) == pytest.approx(want, rel=1e-12, abs=1e-15)
+
+
+def tick_at(t, time):
+    """The documented rule, by search: the last tick k (clamped to the move) with k * ts <= t."""
+    k = 0
+    while k < t.ticks and (k + 1) * t.ts <= time:
+        k += 1
+    return k
+
+
+def test_the_end_of_the_move_is_at_its_duration_whatever_the_tick_count():
+    # t / ts rounds below a whole tick for some tick counts (49 ticks of 1e-4 s, ...): the
+    # state at the move's duration is still its end, at rest, for every move here.
+    rng = random.Random(7)
+    ends = 0
+    for _ in range(200):
+        t = snapgen.plan(10 ** rng.uniform(-4, -2), max_velocity=1.0, max_acceleration=20.0,
+                         max_jerk=2000.0, ts=rng.choice([1e-4, 1e-3, 3e-5]))
+        states = integrate(t)
+        sv = t.scale("velocity")
+        assert t.at_time(t.duration)[1:] == (0.0, 0.0, 0.0)
+        assert t.registers_at(t.ticks) == states[-1]
+        # At each tick's own time, that tick's state (velocities compared exactly).
+        for k in range(0, t.ticks + 1, max(1, t.ticks // 10)):
+            assert t.at_time(k * t.ts)[1] == states[k][1] / sv, k
+        ends += 1
+    assert ends == 200
+    with pytest.raises(ValueError, match="NaN"):
+        t.at_time(float("nan"))
 
 
 def test_peaks_are_the_integrations_peaks():
@@ -187,6 +215,8 @@ def test_replanning_to_a_velocity_holds_it():
 def test_replanning_refuses_what_cannot_be_done():
     with pytest.raises(snapgen.PlanError, match="beyond the velocity limit"):
         snapgen.replan((0, 0, 0, 0), max_velocity=0.5, max_acceleration=2.0, target_velocity=1.0)
+    with pytest.raises(snapgen.PlanError, match="does not fit the board's"):
+        snapgen.replan((0, 1 << 120, 0, 0), max_velocity=0.5, max_acceleration=2.0)
     with pytest.raises(snapgen.PlanError, match="target_position = inf"):
         snapgen.replan((0, 0, 0, 0), max_velocity=0.5, max_acceleration=2.0,
                        target_position=float("inf"))

