@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The Python package (python/, PyO3 + maturin, abi3): builds its wheel, installs it into a
 # venv in the snapgen cache (with NumPy and pytest from PyPI, pinned) and runs its tests
-# (python/tests); then cross-builds the aarch64 wheel when the cross toolchain scripts/arm64.sh
-# installs is there (built, not run: there is no aarch64 Python here). Part of the test command.
+# (python/tests). Part of the test command. With --aarch64 it also cross-builds the aarch64
+# wheel with the cross toolchain scripts/arm64.sh installs (built, not run: there is no aarch64
+# Python here; left out of the test command for its time).
 #
-#   ./scripts/python.sh           # build, install, test; the aarch64 wheel
-#   ./scripts/python.sh --wheel   # build the x86_64 wheel only (into target/wheels)
+#   ./scripts/python.sh             # build, install, test
+#   ./scripts/python.sh --aarch64   # ... and the aarch64 wheel (into target/wheels-arm64)
+#   ./scripts/python.sh --wheel     # build the x86_64 wheel only (into target/wheels)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -33,6 +35,9 @@ fi
 "$venv/bin/pip" install -q --force-reinstall --no-deps "$wheel"
 "$venv/bin/python" -m pytest -q python/tests
 
+if [ "${1:-}" != "--aarch64" ]; then
+  exit 0
+fi
 target=aarch64-unknown-linux-gnu
 if command -v aarch64-linux-gnu-gcc >/dev/null && rustup target list --installed 2>/dev/null | grep -qx "$target"; then
   rm -rf target/wheels-arm64
@@ -45,5 +50,6 @@ if command -v aarch64-linux-gnu-gcc >/dev/null && rustup target list --installed
   [ "$machine" = "b700" ] || { echo "$arm: the extension is not an aarch64 binary ($machine)" >&2; exit 1; }
   echo "built $arm (aarch64, not run here)"
 else
-  echo "no aarch64 cross toolchain (scripts/arm64.sh installs it): the aarch64 wheel was not built"
+  echo "no aarch64 cross toolchain: run scripts/arm64.sh first (it installs it)" >&2
+  exit 1
 fi
