@@ -15,7 +15,6 @@ use snapgen_host::serial::SerialTransport;
 use snapgen_host::session::{Failure, Session};
 use snapgen_model::device::Design;
 use snapgen_model::format::DEFAULT_FORMAT;
-use snapgen_model::timing::Timing;
 use snapgen_plan::MoveRequest;
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::BoardTransport;
@@ -74,13 +73,8 @@ fn open(transport: Box<dyn Transport>, lsb: f64) -> PyResult<Board> {
 
 /// A virtual board's design: the default clock and Ts at `baud`.
 fn design(baud: u32) -> PyResult<Design> {
-    let t = Timing {
-        baud,
-        ..Timing::default()
-    };
-    let d = Design::from_timing(&DEFAULT_FORMAT, &t)
-        .map_err(|e| PlanError::new_err(format!("a board at {baud} baud: {e}")))?;
-    Ok(snapgen_hdl::verilog::io_design(&d))
+    snapgen_sim::board::virtual_design(baud)
+        .map_err(|e| PlanError::new_err(format!("a board at {baud} baud: {e}")))
 }
 
 #[pymethods]

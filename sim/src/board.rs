@@ -46,6 +46,18 @@ pub struct BoardMismatch {
     pub actual: u128,
 }
 
+/// A virtual board's design: the default format, clock and Ts, its UART at `baud`, hashed as
+/// its Verilog is (the design `snapgen board`, `online`, `path` and the Python package's
+/// virtual boards run).
+pub fn virtual_design(baud: u32) -> Result<Design, snapgen_model::timing::TimingError> {
+    let t = snapgen_model::timing::Timing {
+        baud,
+        ..Default::default()
+    };
+    let d = Design::from_timing(&snapgen_model::DEFAULT_FORMAT, &t)?;
+    Ok(snapgen_hdl::verilog::io_design(&d))
+}
+
 /// A virtual board.
 pub struct VirtualBoard {
     design: Design,

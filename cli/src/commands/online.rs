@@ -35,7 +35,6 @@ use snapgen_host::online::{play as play_script, PlayError, PlayOptions};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::Session;
 use snapgen_model::device::Design;
-use snapgen_model::timing::Timing;
 use snapgen_model::{Trace, DEFAULT_FORMAT};
 use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::board::VirtualBoard;
@@ -281,13 +280,7 @@ pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
 
 /// The virtual board's design: the default clock and Ts, at `baud`.
 pub fn design(baud: u32) -> anyhow::Result<Design> {
-    let t = Timing {
-        baud,
-        ..Timing::default()
-    };
-    let d = Design::from_timing(&DEFAULT_FORMAT, &t)
-        .with_context(|| format!("a board at {baud} baud"))?;
-    Ok(snapgen_hdl::verilog::io_design(&d))
+    snapgen_sim::board::virtual_design(baud).with_context(|| format!("a board at {baud} baud"))
 }
 
 /// One command's line in the JSON.
