@@ -338,7 +338,7 @@ impl Board {
                         &self.device,
                         &format!(
                             "give an ECP5 device nextpnr-ecp5 knows: {}",
-                            crate::ecp5::DEVICES
+                            crate::ecp5::devices()
                         ),
                     ));
                 }

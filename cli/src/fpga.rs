@@ -232,45 +232,48 @@ pub enum Runner {
 /// build for a Xilinx board, the open flow for an ECP5 board (with a PLL when the fabric clock
 /// is not the oscillator's; refused when the PLL cannot make it exactly).
 pub fn build_plan(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<BuildPlan> {
-    match b.toolchain() {
-        Toolchain::Vivado => Ok(vivado_plan(b, timing, design)),
+    let osc = b.clock.frequency_hz;
+    let pll = match b.toolchain() {
+        Toolchain::OpenEcp5 if timing.clock_hz != osc => {
+            let s = crate::ecp5::solve_pll(osc, timing.clock_hz).map_err(|e| {
+                crate::error::InputError::Board(format!(
+                    "{}: the fabric clock of {} Hz: {e}",
+                    b.name, timing.clock_hz
+                ))
+            })?;
+            Some((osc, timing.clock_hz, s))
+        }
+        _ => None,
+    };
+    // What every build holds: the motion core, the I/O top and the board top.
+    let top = b.top_name();
+    let mut files = BTreeMap::new();
+    let mut sources = Vec::new();
+    for (name, text) in snapgen_hdl::verilog::io_sources(design) {
+        sources.push(name.to_string());
+        files.insert(name.into(), text);
+    }
+    files.insert(format!("{top}.v"), board_top_verilog(b, timing, pll));
+    let runner = match b.toolchain() {
+        Toolchain::Vivado => {
+            vivado_files(b, timing, &mut files);
+            Runner::Vivado
+        }
         Toolchain::OpenEcp5 => {
-            let osc = b.clock.frequency_hz;
-            let pll = if timing.clock_hz == osc {
-                None
-            } else {
-                let s = crate::ecp5::solve_pll(osc, timing.clock_hz).map_err(|e| {
-                    crate::error::InputError::Board(format!(
-                        "{}: the fabric clock of {} Hz: {e}",
-                        b.name, timing.clock_hz
-                    ))
-                })?;
-                Some((osc, timing.clock_hz, s))
-            };
-            let top = b.top_name();
-            let mut files = BTreeMap::new();
-            let mut sources = Vec::new();
-            for (name, text) in snapgen_hdl::verilog::io_sources(design) {
-                sources.push(name.to_string());
-                files.insert(name.into(), text);
-            }
-            files.insert(format!("{top}.v"), board_top_verilog(b, timing, pll));
             files.insert(format!("{top}.lpf"), crate::ecp5::lpf(b));
             let steps = crate::ecp5::steps(b, &sources);
             files.insert("Makefile".into(), crate::ecp5::makefile(b, &steps));
-            Ok(BuildPlan {
-                files,
-                runner: Runner::Ecp5 {
-                    steps,
-                    clock_hz: timing.clock_hz,
-                },
-            })
+            Runner::Ecp5 {
+                steps,
+                clock_hz: timing.clock_hz,
+            }
         }
-    }
+    };
+    Ok(BuildPlan { files, runner })
 }
 
-/// The Vivado non-project build.
-fn vivado_plan(b: &Board, timing: &Timing, design: &Design) -> BuildPlan {
+/// The Vivado non-project build's own files: the XDC, the TCL script and the Makefile.
+fn vivado_files(b: &Board, timing: &Timing, files: &mut BTreeMap<String, String>) {
     let top = b.top_name();
     let tcl = format!(
         "\
@@ -309,18 +312,9 @@ clean:
         desc = b.description,
         top = top,
     );
-    let mut files = BTreeMap::new();
-    for (name, text) in snapgen_hdl::verilog::io_sources(design) {
-        files.insert(name.into(), text);
-    }
-    files.insert(format!("{top}.v"), board_top_verilog(b, timing, None));
     files.insert(format!("{top}.xdc"), xdc(b, timing));
     files.insert("build.tcl".into(), tcl);
     files.insert("Makefile".into(), makefile);
-    BuildPlan {
-        files,
-        runner: Runner::Vivado,
-    }
 }
 
 impl BuildPlan {

@@ -184,10 +184,8 @@ impl Board {
         };
         let request = MoveRequest { distance, method };
         let r = send_move(&mut self.session, &request, &opts, &mut NoProgress).map_err(failure)?;
-        let order = r.plan.order();
-        let trajectory = Trajectory::new(r.plan.format, r.plan.start, r.plan.program, order);
         Ok(MoveReport {
-            trajectory: Py::new(py, trajectory)?,
+            trajectory: Py::new(py, Trajectory::from(r.plan))?,
             end_registers: (r.state.x, r.state.v, r.state.a, r.state.j),
             ticks: r.status.tick_count,
             stopped: r.stop.is_some(),

@@ -45,6 +45,19 @@ pub struct Trajectory {
     peaks: Peaks,
 }
 
+/// A rest-to-rest plan as a trajectory (its exact peaks taken with it).
+impl From<snapgen_plan::Plan> for Trajectory {
+    fn from(p: snapgen_plan::Plan) -> Self {
+        Trajectory {
+            format: p.format,
+            start: p.start,
+            order: p.order(),
+            peaks: p.peaks,
+            program: p.program,
+        }
+    }
+}
+
 impl Trajectory {
     pub(crate) fn new(format: Format, start: ChainState, program: Program, order: u8) -> Self {
         let (peaks, _) = snapgen_model::peaks::peaks(&program, &start);
@@ -76,13 +89,7 @@ fn format(ts: f64, lsb: f64) -> PyResult<Format> {
 
 fn planned(request: MoveRequest, f: &Format) -> PyResult<Trajectory> {
     snapgen_plan::plan(&request, f)
-        .map(|p| Trajectory {
-            format: *f,
-            start: p.start,
-            order: p.order(),
-            peaks: p.peaks,
-            program: p.program,
-        })
+        .map(Trajectory::from)
         .map_err(|e| PlanError::new_err(e.to_string()))
 }
 

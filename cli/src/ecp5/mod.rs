@@ -13,25 +13,33 @@ pub use pll::{solve_pll, PllSetting};
 
 use crate::board_spec::{Board, Pull};
 
+/// The ECP5 devices nextpnr-ecp5 places, with its option for each.
+const DEVICE_OPTIONS: [(&str, &str); 10] = [
+    ("LFE5U-12F", "--12k"),
+    ("LFE5U-25F", "--25k"),
+    ("LFE5U-45F", "--45k"),
+    ("LFE5U-85F", "--85k"),
+    ("LFE5UM-25F", "--um-25k"),
+    ("LFE5UM-45F", "--um-45k"),
+    ("LFE5UM-85F", "--um-85k"),
+    ("LFE5UM5G-25F", "--um5g-25k"),
+    ("LFE5UM5G-45F", "--um5g-45k"),
+    ("LFE5UM5G-85F", "--um5g-85k"),
+];
+
 /// nextpnr-ecp5's device option for a device name (`LFE5U-85F` → `--85k`), or `None`.
 pub fn nextpnr_device(device: &str) -> Option<&'static str> {
-    Some(match device {
-        "LFE5U-12F" => "--12k",
-        "LFE5U-25F" => "--25k",
-        "LFE5U-45F" => "--45k",
-        "LFE5U-85F" => "--85k",
-        "LFE5UM-25F" => "--um-25k",
-        "LFE5UM-45F" => "--um-45k",
-        "LFE5UM-85F" => "--um-85k",
-        "LFE5UM5G-25F" => "--um5g-25k",
-        "LFE5UM5G-45F" => "--um5g-45k",
-        "LFE5UM5G-85F" => "--um5g-85k",
-        _ => return None,
-    })
+    DEVICE_OPTIONS
+        .iter()
+        .find(|(name, _)| *name == device)
+        .map(|(_, option)| *option)
 }
 
 /// The device names [`nextpnr_device`] knows, for error messages.
-pub const DEVICES: &str = "LFE5U-12F, LFE5U-25F, LFE5U-45F, LFE5U-85F, LFE5UM-25F, LFE5UM-45F, LFE5UM-85F, LFE5UM5G-25F, LFE5UM5G-45F, LFE5UM5G-85F";
+pub fn devices() -> String {
+    let names: Vec<&str> = DEVICE_OPTIONS.iter().map(|(name, _)| *name).collect();
+    names.join(", ")
+}
 
 /// The constraints (LPF): every pin's site and I/O type, its pull where the board file gives
 /// one, and the oscillator's frequency (nextpnr derives the PLL output's from it).
