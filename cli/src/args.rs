@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use snapgen_host::link::{FramedLink, RetryPolicy};
+use snapgen_host::driver::RunOptions;
+use snapgen_host::link::{FramedLink, LinkError, RetryPolicy, Transport};
 use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::{Failure, Session};
 use snapgen_model::device::Design;
@@ -320,13 +321,19 @@ impl BoardArgs {
     }
 }
 
-/// A serial link to a board, with the host's retry policy (docs/PROTOCOL.md, "Retries").
+/// A link to a board — a serial port, or the station's AXI4-Lite registers through a UIO
+/// device on the board's own processor — with the host's retry policy (docs/PROTOCOL.md,
+/// "Retries").
 #[derive(Args, Debug, Clone)]
 pub struct LinkArgs {
     /// Serial device (a real board's USB-UART, or the path `snapgen board --pty` prints).
+    #[arg(long, required_unless_present = "uio", conflicts_with = "uio")]
+    pub port: Option<String>,
+    /// The station's UIO device instead of a serial port (`/dev/uioN`, on a Zynq running the
+    /// AXI4-Lite design: docs/AXI.md).
     #[arg(long)]
-    pub port: String,
-    /// Baud rate.
+    pub uio: Option<PathBuf>,
+    /// Baud rate (serial port).
     #[arg(long, default_value_t = 115_200)]
     pub baud: u32,
     /// Reply timeout per attempt, in milliseconds (above the board's inter-byte timeout and a
@@ -338,21 +345,63 @@ pub struct LinkArgs {
     pub retries: u32,
 }
 
-/// A session with the board on a serial port.
-pub type SerialSession = Session<FramedLink<SerialTransport>>;
+/// A session with a board on a serial port or a UIO device.
+pub type BoardSession = Session<FramedLink<Box<dyn Transport>>>;
 
 impl LinkArgs {
-    /// Opens the port and begins a session (PING, the board's format; `position_lsb` is the
-    /// host's scale).
-    pub fn open(&self, position_lsb: f64) -> Result<SerialSession, Failure> {
+    /// Opens the port (or the UIO device) and begins a session (PING, the board's format;
+    /// `position_lsb` is the host's scale).
+    pub fn open(&self, position_lsb: f64) -> Result<BoardSession, Failure> {
         let policy = RetryPolicy {
             timeout: self.timeout_ms as f64 / 1e3,
             retries: self.retries,
             ..Default::default()
         };
-        let t = SerialTransport::open(&self.port, self.baud)?;
+        let Some((t, _)) = direct_link(self.port.as_deref(), self.uio.as_deref(), self.baud)?
+        else {
+            return Err(LinkError::Io("give --port PORT or --uio /dev/uioN".into()).into());
+        };
         Session::open(FramedLink::new(t, policy, session_seq()), position_lsb)
     }
+}
+
+/// A real board's medium and the driver's run options for it (a memory-mapped link needs less
+/// lead than a serial one).
+pub type DirectLink = (Box<dyn Transport>, RunOptions);
+
+/// A real board given by `--port` or `--uio` (None: neither, a virtual board).
+pub fn direct_link(
+    port: Option<&str>,
+    uio: Option<&Path>,
+    baud: u32,
+) -> Result<Option<DirectLink>, Failure> {
+    Ok(match (port, uio) {
+        (_, Some(uio)) => Some((Box::new(open_uio(uio)?), RunOptions::memory_mapped())),
+        (Some(port), None) => Some((
+            Box::new(SerialTransport::open(port, baud)?),
+            RunOptions::default(),
+        )),
+        (None, None) => None,
+    })
+}
+
+/// The station behind the UIO device `path` (Linux only).
+#[cfg(target_os = "linux")]
+pub fn open_uio(
+    path: &Path,
+) -> Result<snapgen_host::uio::RegisterTransport<snapgen_host::uio::Uio>, Failure> {
+    let regs = snapgen_host::uio::Uio::open(path)?;
+    Ok(snapgen_host::uio::RegisterTransport::open(regs)?)
+}
+
+/// The station behind a UIO device: Linux only.
+#[cfg(not(target_os = "linux"))]
+pub fn open_uio(path: &Path) -> Result<SerialTransport, Failure> {
+    Err(LinkError::Io(format!(
+        "--uio {}: UIO devices are Linux's (a Zynq running Linux)",
+        path.display()
+    ))
+    .into())
 }
 
 impl PlanArgs {

@@ -53,6 +53,11 @@ enum Command {
     /// switches, emergency stop) against the device model, every output on every clock, under
     /// random command streams; exit 1 on any mismatch (the waves around it are written).
     CosimIo(cosim_io::Args),
+    /// Co-simulate the AXI4-Lite top (issue 23: the station behind an AXI4-Lite slave)
+    /// against its model, every output on every clock, under random AXI traffic with random
+    /// back-pressure, the handshake rules checked on the fabric's outputs; exit 1 on any
+    /// mismatch or broken rule.
+    CosimAxi(cosim_axi::Args),
     /// Co-simulate the path interpolator (issue 22: a distance into a line or arc becomes
     /// each axis's position) against its model, every output on every clock, under random
     /// segments from the path planner; exit 1 on any mismatch.
@@ -117,6 +122,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Spec(a) => spec::run(a),
         Command::Cosim(a) => cosim::run(a),
         Command::CosimIo(a) => cosim_io::run(a),
+        Command::CosimAxi(a) => cosim_axi::run(a),
         Command::CosimInterp(a) => cosim_interp::run(a),
         Command::CosimPathCore(a) => cosim_path_core::run(a),
         Command::Online(a) => online::run(a),

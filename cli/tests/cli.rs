@@ -828,3 +828,23 @@ fn cosim_path_core_reports_and_fails_on_a_fault() {
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(text.contains("step") && text.contains("12345"), "{text}");
 }
+
+/// `--uio`: a device that is not there, or that is no station's register map, is refused with
+/// what to check (exit 1); `--port` and `--uio` together are a usage error (exit 2).
+#[test]
+fn uio_links_refuse_what_is_no_station() {
+    let out = snapgen(&["stop", "--uio", "/dev/snapgen-no-such-uio"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cannot open the UIO device"), "{err}");
+    let out = snapgen(&["stop", "--uio", "/dev/null"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cannot map its registers"), "{err}");
+    let out = snapgen(&["stop", "--uio", "/dev/null", "--port", "/dev/null"]);
+    assert_eq!(out.status.code(), Some(2));
+    let mut send = vec!["send", "--uio", "/dev/snapgen-no-such-uio"];
+    send.extend_from_slice(ORDER4);
+    let out = snapgen(&send);
+    assert_eq!(out.status.code(), Some(1));
+}

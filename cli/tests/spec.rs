@@ -181,8 +181,12 @@ fn update_docs_restores_a_generated_table() {
     let mut edited = good.clone();
     edited.insert_str(row, "| edited by hand |\n");
     std::fs::write(&copy, &edited).unwrap();
-    let boards = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/BOARDS.md");
-    std::fs::copy(&boards, dir.join("BOARDS.md")).unwrap();
+    for other in ["BOARDS.md", "AXI.md"] {
+        let page = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../docs")
+            .join(other);
+        std::fs::copy(&page, dir.join(other)).unwrap();
+    }
     let run = || {
         let out = snapgen_ok(&["spec", "--update-docs", "--docs", dir.to_str().unwrap()]);
         String::from_utf8_lossy(&out.stdout).into_owned()
@@ -193,5 +197,5 @@ fn update_docs_restores_a_generated_table() {
         "{first}"
     );
     assert_eq!(std::fs::read_to_string(&copy).unwrap(), good);
-    assert_eq!(run().matches("is up to date").count(), 2);
+    assert_eq!(run().matches("is up to date").count(), 3);
 }

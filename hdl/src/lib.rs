@@ -20,6 +20,7 @@
 //! * Its simulator is slow past 32 bits: the blocks' own tests are short; long runs use
 //!   Verilator (`snapgen-sim`).
 
+pub mod axi_top;
 pub mod byte_fifo;
 pub mod chain;
 pub mod core;
@@ -46,6 +47,7 @@ pub mod sequencer;
 pub mod servo;
 pub mod sign_extend;
 pub mod sim_bits;
+pub mod station;
 pub mod status_block;
 pub mod step_dir;
 pub mod stop_unit;

@@ -92,6 +92,20 @@ impl<const N: usize> Drive<i128> for Signal<Out, Bits<N>> {
     }
 }
 
+impl<const N: usize> Drive<snapgen_spec::Status> for Signal<Out, Bits<N>> {
+    fn drive(&mut self, v: snapgen_spec::Status) {
+        // The status block's bytes, byte 0 in bits 7:0.
+        let mut bytes = [0u8; snapgen_spec::Status::BYTES];
+        v.write_payload(&mut bytes);
+        self.next = bytes
+            .iter()
+            .enumerate()
+            .fold(Bits::<N>::default(), |b, (k, &byte)| {
+                (0..8).fold(b, |b, i| b.replace_bit(8 * k + i, (byte >> i) & 1 == 1))
+            });
+    }
+}
+
 /// For a block that writes its own Verilog and runs its model (its field `_sim`) in rust-hdl's
 /// simulator, from the spec's port list (called through its `with_*_ports!` macro): its
 /// `Logic`, whose `update` clocks the model with every input port (into the model's input

@@ -52,9 +52,23 @@ pub fn core_waivers() -> Vec<Waiver> {
     w
 }
 
-/// Every waiver and hint of the I/O top design.
-pub fn io_top_waivers() -> Vec<Waiver> {
+/// Every waiver and hint of the station with its motion core.
+pub fn station_waivers() -> Vec<Waiver> {
     let mut w = core_waivers();
+    w.extend_from_slice(&crate::station::WAIVERS);
+    w
+}
+
+/// Every waiver and hint of the I/O top design (the station's and the UART top's).
+pub fn io_top_waivers() -> Vec<Waiver> {
+    let mut w = station_waivers();
+    w.extend_from_slice(&crate::io_top::WAIVERS);
+    w
+}
+
+/// The I/O top's own waivers and the station's (the motion core is a design of its own).
+fn io_file_waivers() -> Vec<Waiver> {
+    let mut w = crate::station::WAIVERS.to_vec();
     w.extend_from_slice(&crate::io_top::WAIVERS);
     w
 }
@@ -108,9 +122,14 @@ pub fn io_top_verilog(design: &Design) -> String {
     let io = netlist_of(&generate_verilog(&uut), IO_PREFIX)
         .and_then(|io| {
             let core = netlist_of(&motion_core_raw(), CORE_PREFIX)?;
-            crate::netlist::use_child_design(&io, &format!("{IO_PREFIX}_core"), &core, CORE_PREFIX)
+            crate::netlist::use_child_design(
+                &io,
+                &format!("{IO_PREFIX}_station_core"),
+                &core,
+                CORE_PREFIX,
+            )
         })
-        .and_then(|io| finish(&io, IO_PREFIX, &header, &crate::io_top::WAIVERS))
+        .and_then(|io| finish(&io, IO_PREFIX, &header, &io_file_waivers()))
         .expect("the I/O top's names, waivers and motion core are checked by its tests");
     io
 }

@@ -3,7 +3,8 @@
 //! * [`protocol`]: the protocol's codecs (commands to frames, frames to replies, the stream
 //!   decoder) over the tables of `snapgen_spec`.
 //! * [`link`]: the one [`link::Link`] every host talks through, its one retry policy, and
-//!   [`link::FramedLink`] over any byte [`link::Transport`]; [`serial`] is the serial port.
+//!   [`link::FramedLink`] over any byte [`link::Transport`]; [`serial`] is the serial port,
+//!   [`uio`] the station's AXI4-Lite registers (a `/dev/uioN` mapping on the board's ARM).
 //! * [`session`]: a session with a board (PING, its format, typed requests) and the errors a
 //!   host reports.
 //! * [`limits`]: the one rule for the board's controlled-stop limits.
@@ -23,3 +24,4 @@ pub mod protocol;
 pub mod send;
 pub mod serial;
 pub mod session;
+pub mod uio;

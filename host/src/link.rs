@@ -170,6 +170,11 @@ impl<T: Transport> FramedLink<T> {
         &self.transport
     }
 
+    /// The medium, the link given up.
+    pub fn into_transport(self) -> T {
+        self.transport
+    }
+
     /// The medium, mutably (a virtual board's world: switches, injected faults).
     pub fn transport_mut(&mut self) -> &mut T {
         &mut self.transport

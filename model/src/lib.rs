@@ -11,7 +11,9 @@
 //!   unit, chain, swap timer).
 //! * [`io`]: the I/O blocks clock by clock (UART, FIFOs, frame receiver, executor, reply
 //!   transmitter, encoder, PWM, position controller).
-//! * [`device`]: the I/O top clock by clock: the board as the host sees it.
+//! * [`station`]: everything of the I/O top but its transport, clock by clock.
+//! * [`device`]: the I/O top clock by clock (the station behind a UART): the board as the
+//!   host sees it.
 //! * [`peer`]: the other end of the board's UART (a byte stream as line levels and back).
 //!
 //! This crate does no I/O.
@@ -27,6 +29,7 @@ pub mod peaks;
 pub mod peer;
 pub mod ports;
 pub mod program;
+pub mod station;
 pub mod stop;
 pub mod timing;
 

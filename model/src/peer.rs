@@ -148,8 +148,14 @@ impl Peer {
         if r.valid {
             self.received.push(r.data);
         }
+        self.observe_status(&o.status);
+    }
+
+    /// The board's status block after the edge, for a board without a UART (the AXI top):
+    /// the encoder follows its position.
+    pub fn observe_status(&mut self, status: &snapgen_spec::Status) {
         if self.follow {
-            self.target = i64::from(o.status.position);
+            self.target = i64::from(status.position);
         }
     }
 }

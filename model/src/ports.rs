@@ -7,6 +7,10 @@
 //!   its `status` section (what the executor reads).
 //! * [`IoInputs`], [`IoOutputs`]: the I/O top's pins (`snapgen_io`) for one clock, the status
 //!   block as a [`snapgen_spec::Status`].
+//! * [`StationInputs`], [`StationOutputs`]: the station (`snapgen_io_station`,
+//!   [`crate::station`]) for one clock.
+//! * [`AxiInputs`], [`AxiOutputs`]: the AXI4-Lite top (`snapgen_axi`, [`crate::io::axi`]) for
+//!   one clock.
 //! * [`InterpInputs`], [`InterpOutputs`]: the path interpolator (`snapgen_interpolator`,
 //!   [`crate::path::engine`]) for one clock.
 //! * [`StepDirInputs`], [`StepDirOutputs`]: the step/dir generator (`snapgen_step_dir`,
@@ -44,6 +48,8 @@ snapgen_spec::with_motion_core_ports!(
     port_structs! { CoreInputs, CoreOutputs, "the motion core"; }
 );
 snapgen_spec::with_io_top_ports!(port_structs! { IoInputs, IoOutputs, "the I/O top"; });
+snapgen_spec::with_station_ports!(port_structs! { StationInputs, StationOutputs, "the station"; });
+snapgen_spec::with_axi_top_ports!(port_structs! { AxiInputs, AxiOutputs, "the AXI4-Lite top"; });
 snapgen_spec::with_interpolator_ports!(port_structs! {
     InterpInputs, InterpOutputs, "the path interpolator";
 });

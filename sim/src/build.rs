@@ -144,6 +144,20 @@ pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
     )
 }
 
+/// Builds (or finds in the cache) the library of the AXI4-Lite design `verilog` (every source
+/// of it: the generator's, or a deliberately altered copy; [`crate::axi`]), with VCD tracing
+/// if `trace`.
+pub fn build_axi(verilog: &str, trace: bool) -> Result<Built, SimError> {
+    build_with(
+        "axi",
+        snapgen_hdl::axi_top::AXI_PREFIX,
+        verilog,
+        HARNESS_CPP,
+        &crate::axi::axi_layout_header(),
+        trace,
+    )
+}
+
 /// Builds (or finds in the cache) the library of the path interpolator for `axes` axes
 /// ([`crate::interp`]), with VCD tracing if `trace`.
 pub fn build_interpolator(axes: u8, trace: bool) -> Result<Built, SimError> {

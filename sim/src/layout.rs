@@ -23,6 +23,39 @@ pub trait PortValue: Copy {
     fn to_word(self) -> u128;
     /// From a port's raw bits.
     fn from_word(v: u128, bits: u32) -> Self;
+    /// Writes the value into its slot of `w` (a port wider than 128 bits writes its words
+    /// itself).
+    #[inline(always)]
+    fn put_into(self, slot: &Slot, w: &mut [u32]) {
+        slot.put(w, self.to_word());
+    }
+}
+
+/// The status block (240 bits): its bytes from the slot's first word up, byte 0 in bits 7:0.
+/// `to_word`/`from_word` carry its first 16 bytes only; [`PortValue::put_into`] writes it
+/// whole, and [`first_difference`] compares a wide port word by word.
+impl PortValue for snapgen_spec::Status {
+    fn to_word(self) -> u128 {
+        let mut bytes = [0u8; 16];
+        let mut all = [0u8; snapgen_spec::Status::BYTES];
+        self.write_payload(&mut all);
+        bytes.copy_from_slice(&all[..16]);
+        u128::from_le_bytes(bytes)
+    }
+    fn from_word(v: u128, _: u32) -> Self {
+        let mut all = [0u8; snapgen_spec::Status::BYTES];
+        all[..16].copy_from_slice(&v.to_le_bytes());
+        snapgen_spec::Status::from_payload(&all).expect("the status block's length")
+    }
+    fn put_into(self, slot: &Slot, w: &mut [u32]) {
+        let mut bytes = [0u8; snapgen_spec::Status::BYTES];
+        self.write_payload(&mut bytes);
+        for (k, b) in bytes.into_iter().enumerate() {
+            let word = slot.word + k / 4;
+            let shift = 8 * (k % 4);
+            w[word] = (w[word] & !(0xFF << shift)) | (u32::from(b) << shift);
+        }
+    }
 }
 
 impl PortValue for bool {
@@ -118,10 +151,15 @@ impl Slot {
         }
     }
 
-    /// Flips bit `bit` (modulo its width) of the port in `w`.
+    /// Flips bit `bit` (modulo its width) of the port in `w` (any width).
     pub fn flip(&self, w: &mut [u32], bit: u32) {
-        let v = self.get(w) ^ (1u128 << (bit % self.bits));
-        self.put(w, v);
+        let at = self.shift + bit % self.bits;
+        w[self.word + (at / 32) as usize] ^= 1 << (at % 32);
+    }
+
+    /// The words of a wide port (more than 32 bits), in `w`.
+    pub fn words_in<'a>(&self, w: &'a [u32]) -> &'a [u32] {
+        &w[self.word..self.word + self.words()]
     }
 
     /// Writes `v` (its low `bits` bits) into `w` (ports of at most 128 bits).
@@ -171,9 +209,9 @@ pub struct PortMismatch {
     pub clock: u64,
     /// The output port.
     pub port: &'static str,
-    /// The model's bits.
+    /// The model's bits (of a port wider than 128 bits, its first differing 32-bit word).
     pub expected: u128,
-    /// The fabric's bits.
+    /// The fabric's bits (likewise).
     pub actual: u128,
 }
 
@@ -203,6 +241,17 @@ pub fn first_difference(
         .enumerate()
         .find_map(|(c, (g, w))| {
             ports.iter().zip(slots).find_map(|(p, s)| {
+                if s.bits > 128 {
+                    // A wide port: its first differing word.
+                    let (g, w) = (s.words_in(g), s.words_in(w));
+                    let k = g.iter().zip(w).position(|(a, b)| a != b)?;
+                    return Some(PortMismatch {
+                        clock: first + c as u64,
+                        port: p.name,
+                        expected: u128::from(w[k]),
+                        actual: u128::from(g[k]),
+                    });
+                }
                 let (actual, expected) = (s.get(g), s.get(w));
                 (actual != expected).then_some(PortMismatch {
                     clock: first + c as u64,
@@ -306,7 +355,7 @@ macro_rules! port_layout {
         pub fn encode_inputs(i: &$ity) -> [u32; IN_WORDS] {
             let mut w = [0u32; IN_WORDS];
             let mut k = 0;
-            $($( IN_SLOTS[k].put(&mut w, $crate::layout::PortValue::to_word(i.$i)); k += 1; )*)*
+            $($( $crate::layout::PortValue::put_into(i.$i, &IN_SLOTS[k], &mut w); k += 1; )*)*
             debug_assert_eq!(k, IN_SLOTS.len());
             w
         }
@@ -317,7 +366,7 @@ macro_rules! port_layout {
         pub fn encode_outputs(o: &$oty) -> [u32; OUT_WORDS] {
             let mut w = [0u32; OUT_WORDS];
             let mut k = 0;
-            $($( OUT_SLOTS[k].put(&mut w, $crate::layout::PortValue::to_word(o.$o)); k += 1; )*)*
+            $($( $crate::layout::PortValue::put_into(o.$o, &OUT_SLOTS[k], &mut w); k += 1; )*)*
             debug_assert_eq!(k, OUT_SLOTS.len());
             w
         }

@@ -11,10 +11,16 @@
 //! * [`moves`] makes the random move streams `snapgen cosim` plays.
 //! * [`io`] loads the Verilated I/O top; [`io_cosim`] runs it in lockstep with the device
 //!   model under random command streams; [`board`] is the virtual board on it.
+//! * [`axi`] loads the Verilated AXI4-Lite top; [`axi_cosim`] runs it in lockstep with its
+//!   model under random AXI traffic, the handshake rules checked; [`axi_board`] is the virtual
+//!   board behind its registers that the host's UIO link drives.
 //! * [`interp`] runs the path interpolator in lockstep with its model, [`path_seq`] the path
 //!   sequencer, [`step_dir`] the step/dir generator, [`path_steppers`] the N-axis stage made
 //!   of them (issue 22).
 
+pub mod axi;
+pub mod axi_board;
+pub mod axi_cosim;
 pub mod board;
 pub mod build;
 pub mod closed_loop;

@@ -17,6 +17,7 @@
 //!
 //! This crate depends on no other snapgen crate, does no I/O and panics on no input.
 
+pub mod axi;
 pub mod codes;
 pub mod emit;
 pub mod fields;

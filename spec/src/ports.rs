@@ -152,19 +152,121 @@ macro_rules! with_motion_core_ports {
     };
 }
 
-/// Calls `$callback! { $($extra)* <the I/O top's ports> }` (see the module documentation).
-/// The `axis` sections are one axis's pins.
+/// Calls `$callback! { $($extra)* <the I/O top's ports> }` (see the module documentation):
+/// the station behind a UART (`snapgen_io`). The `axis` sections are one axis's pins.
 #[macro_export]
 macro_rules! with_io_top_ports {
-    ($callback:ident ! { $($extra:tt)* }) => {
-        $callback! { $($extra)*
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $crate::with_front_ports! { $($callback)::+ ! { $($extra)* }
+            front_inputs {
+                link {
+                    uart_rx: bit[1] bool, "UART receive line (idles high).";
+                }
+            }
+            front_outputs {
+                link {
+                    uart_tx: bit[1] bool, "UART transmit line.";
+                }
+            }
+            station_outputs {}
+        }
+    };
+}
+
+/// Calls `$callback! { $($extra)* <the station's ports> }` (see the module documentation):
+/// everything of the I/O top but its transport (`snapgen_io_station`, in `snapgen_io.v`). A
+/// front (the UART of `snapgen_io`, the AXI4-Lite slave of `snapgen_axi`) hands it the
+/// command stream's bytes and takes its replies' bytes; it gives the front the chain's
+/// registers for a snapshot.
+#[macro_export]
+macro_rules! with_station_ports {
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $crate::with_front_ports! { $($callback)::+ ! { $($extra)* }
+            front_inputs {
+                link {
+                    link_valid: bit[1] bool, "A byte of the command stream on this clock (at most one every other clock).";
+                    link_data: bits[8] u8, "The byte.";
+                    link_error: bit[1] bool, "The transport saw a framing error on this clock (UART_ERROR; the frame receiver drops the frame).";
+                    reply_take: bit[1] bool, "The front takes `reply_data` on this clock (ignored while `reply_ready` is low).";
+                }
+            }
+            front_outputs {
+                link {
+                    reply_ready: bit[1] bool, "A byte of the reply stream waits.";
+                    reply_data: bits[8] u8, "The byte that waits.";
+                }
+            }
+            station_outputs {
+                state {
+                    ticks: bits[$crate::widths::TIME_BITS] u64, "Ticks since reset: the board's time base.";
+                    x: bits[$crate::widths::X_BITS] i128, "Position register, raw.";
+                    v: bits[$crate::widths::V_BITS] i128, "Velocity register, raw.";
+                    a: bits[$crate::widths::A_BITS] i128, "Acceleration register, raw.";
+                    j: bits[$crate::widths::J_BITS] i128, "Jerk register, raw.";
+                }
+            }
+        }
+    };
+}
+
+/// Calls `$callback! { $($extra)* <the AXI4-Lite top's ports> }` (see the module
+/// documentation): the station behind an AXI4-Lite slave (`snapgen_axi`), its register map
+/// [`crate::axi::REGISTERS`]. The AXI ports keep the AXI names (`s_axi_*`) so that Vivado's
+/// IP packager infers the interface; the clock and the (active-high) reset are the design's.
+#[macro_export]
+macro_rules! with_axi_top_ports {
+    ($($callback:ident)::+ ! { $($extra:tt)* }) => {
+        $crate::with_front_ports! { $($callback)::+ ! { $($extra)* }
+            front_inputs {
+                axi {
+                    s_axi_awvalid: bit[1] bool, "Write address valid.";
+                    s_axi_awaddr: bits[$crate::axi::ADDR_BITS] u8, "Write address (bytes; the low two bits are ignored).";
+                    s_axi_wvalid: bit[1] bool, "Write data valid.";
+                    s_axi_wdata: bits[32] u32, "Write data.";
+                    s_axi_wstrb: bits[4] u8, "Write strobes: byte lane k is written when bit k is set.";
+                    s_axi_bready: bit[1] bool, "Write response ready.";
+                    s_axi_arvalid: bit[1] bool, "Read address valid.";
+                    s_axi_araddr: bits[$crate::axi::ADDR_BITS] u8, "Read address (bytes; the low two bits are ignored).";
+                    s_axi_rready: bit[1] bool, "Read data ready.";
+                }
+            }
+            front_outputs {
+                axi {
+                    s_axi_awready: bit[1] bool, "Write address ready.";
+                    s_axi_wready: bit[1] bool, "Write data ready.";
+                    s_axi_bvalid: bit[1] bool, "Write response valid.";
+                    s_axi_bresp: bits[2] u8, "Write response: 0 OKAY, 2 SLVERR (no such register, or read-only).";
+                    s_axi_arready: bit[1] bool, "Read address ready.";
+                    s_axi_rvalid: bit[1] bool, "Read data valid.";
+                    s_axi_rdata: bits[32] u32, "Read data.";
+                    s_axi_rresp: bits[2] u8, "Read response: 0 OKAY, 2 SLVERR (no such register, or write-only).";
+                    irq: bit[1] bool, "Interrupt, active high, level: an enabled cause of IRQ_STATUS is set (registered).";
+                }
+            }
+            station_outputs {}
+        }
+    };
+}
+
+/// The I/O tops' common list: the station's pins and debug outputs around a front's own
+/// ports (see [`with_io_top_ports!`], [`with_station_ports!`], [`with_axi_top_ports!`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! with_front_ports {
+    (
+        $($callback:ident)::+ ! { $($extra:tt)* }
+        front_inputs { $($fi:tt)* }
+        front_outputs { $($fo:tt)* }
+        station_outputs { $($so:tt)* }
+    ) => {
+        $($callback)::+ ! { $($extra)*
             clock: "Fabric clock.";
             inputs {
                 reset {
                     reset: bit[1] bool, "Synchronous reset, active high.";
                 }
+                $($fi)*
                 machine {
-                    uart_rx: bit[1] bool, "UART receive line (idles high).";
                     estop: bit[1] bool, "Emergency stop (polarity set by INPUT_POLARITY).";
                 }
                 axis {
@@ -176,11 +278,11 @@ macro_rules! with_io_top_ports {
                 }
             }
             outputs {
+                $($fo)*
                 machine {
-                    uart_tx: bit[1] bool, "UART transmit line.";
                     led_idle: bit[1] bool, "LED 0: idle.";
                     led_busy: bit[1] bool, "LED 1: busy (a program plays or a stop runs).";
-                    led_fault: bit[1] bool, "LED 2: fault (ErrorStop, a UART framing error or an encoder error seen).";
+                    led_fault: bit[1] bool, "LED 2: fault (ErrorStop, a framing error on the link or an encoder error seen).";
                     led_heartbeat: bit[1] bool, "LED 3: heartbeat.";
                 }
                 axis {
@@ -188,6 +290,7 @@ macro_rules! with_io_top_ports {
                     dir: bit[1] bool, "Direction output.";
                     amplifier: bit[1] bool, "Amplifier enable (low: the amplifier must not drive the motor).";
                 }
+                $($so)*
                 debug {
                     status: bits[$crate::fields::STATUS_BITS as u32] $crate::fields::Status, "The status block as the device would report it now (docs/PROTOCOL.md), byte 0 in bits 7:0: for co-simulation and debugging.";
                 }
@@ -529,6 +632,8 @@ macro_rules! block_table {
 
 with_motion_core_ports!(block_table! { MOTION_CORE, "the motion core (`snapgen_core`)"; });
 with_io_top_ports!(block_table! { IO_TOP, "the I/O top (`snapgen_io`)"; });
+with_station_ports!(block_table! { STATION, "the station (`snapgen_io_station`)"; });
+with_axi_top_ports!(block_table! { AXI_TOP, "the AXI4-Lite top (`snapgen_axi`)"; });
 with_interpolator_ports!(
     block_table! { INTERPOLATOR, "the path interpolator (`snapgen_interpolator`)"; }
 );
@@ -651,6 +756,8 @@ mod tests {
         for b in [
             MOTION_CORE,
             IO_TOP,
+            STATION,
+            AXI_TOP,
             INTERPOLATOR,
             STEP_DIR,
             PATH_SEQUENCER,
@@ -668,6 +775,23 @@ mod tests {
         assert_eq!(MOTION_CORE.port("x").map(|p| p.bits), Some(112));
         assert_eq!(MOTION_CORE.section("command").count(), 12);
         assert_eq!(IO_TOP.port("status").map(|p| p.bits), Some(240));
+    }
+
+    #[test]
+    fn each_front_carries_the_stations_pins() {
+        // Every station port but its link to the front and its registers for a snapshot is
+        // the UART top's and the AXI top's port of the same name, direction and width.
+        for p in STATION
+            .ports
+            .iter()
+            .filter(|p| !matches!(p.section, "link" | "state"))
+        {
+            for front in [IO_TOP, AXI_TOP] {
+                let q = front.port(p.name).unwrap_or_else(|| panic!("{}", p.name));
+                assert_eq!((q.dir, q.bits), (p.dir, p.bits), "{}", p.name);
+            }
+        }
+        assert_eq!(AXI_TOP.section("axi").count(), 18);
     }
 
     #[test]

@@ -222,6 +222,7 @@ pub fn demo(out: &Path) -> anyhow::Result<()> {
         &super::online::Target {
             board: super::online::BoardKind::Fabric,
             port: None,
+            uio: None,
             baud: snapgen_model::timing::DEFAULT_BAUD,
         },
     )?;

@@ -3,6 +3,7 @@
 pub mod board;
 pub mod build;
 pub mod cosim;
+pub mod cosim_axi;
 pub mod cosim_interp;
 pub mod cosim_io;
 pub mod cosim_path_core;

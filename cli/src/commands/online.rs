@@ -32,11 +32,12 @@ use snapgen_host::axis::{Goal, MotionCommand, Outcome};
 use snapgen_host::driver::{Action, Event, RunOptions, RunReport};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
 use snapgen_host::online::{play as play_script, PlayError, PlayOptions};
-use snapgen_host::serial::{session_seq, SerialTransport};
+use snapgen_host::serial::session_seq;
 use snapgen_host::session::Session;
 use snapgen_model::device::Design;
 use snapgen_model::{Trace, DEFAULT_FORMAT};
 use snapgen_plan::online::OnlineOrder;
+use snapgen_sim::axi_board::{axi_link, AxiBoard};
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
 
@@ -60,12 +61,18 @@ pub struct Args {
     #[arg(long, requires = "scenario")]
     jerk: Option<f64>,
     /// The virtual board: the device model, or the Verilated I/O top with the device model
-    /// in lockstep (every output compared on every clock).
-    #[arg(long, value_enum, default_value = "model", conflicts_with = "port")]
+    /// in lockstep (every output compared on every clock); behind its UART, or behind the
+    /// AXI4-Lite slave (`axi-model`, `axi-fabric`: the host's UIO link on a simulated memory
+    /// map, docs/AXI.md).
+    #[arg(long, value_enum, default_value = "model", conflicts_with_all = ["port", "uio"])]
     board: BoardKind,
     /// A real board's serial port instead of a virtual board.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "uio")]
     port: Option<String>,
+    /// A real board's station through its UIO device (`/dev/uioN`, on the board's own
+    /// processor: docs/AXI.md) instead of a virtual board.
+    #[arg(long)]
+    uio: Option<PathBuf>,
     /// Baud rate: the virtual board's UART (its design) or the port's.
     #[arg(long, default_value_t = 115_200)]
     baud: u32,
@@ -97,6 +104,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let target = Target {
         board: a.board,
         port: a.port,
+        uio: a.uio,
         baud: a.baud,
     };
     let played = play(script, &target)?;
@@ -188,13 +196,13 @@ impl Script {
         }
     }
 
-    /// How the host plays it.
-    fn options(&self) -> PlayOptions {
+    /// How the host plays it, with the run options `run` (the link's).
+    fn options(&self, run: RunOptions) -> PlayOptions {
         PlayOptions {
             order: self.order(),
             stop_deceleration: self.stop_deceleration,
             stop_jerk: self.stop_jerk,
-            run: RunOptions::default(),
+            run,
         }
     }
 }
@@ -206,6 +214,10 @@ pub enum BoardKind {
     Model,
     /// The Verilated I/O top, the device model in lockstep (every output compared).
     Fabric,
+    /// The AXI4-Lite top's model, through the host's UIO link on a simulated memory map.
+    AxiModel,
+    /// The Verilated AXI4-Lite top, its model in lockstep, through the UIO link.
+    AxiFabric,
 }
 
 /// Where to run.
@@ -214,6 +226,8 @@ pub struct Target {
     pub board: BoardKind,
     /// A serial port.
     pub port: Option<String>,
+    /// A UIO device.
+    pub uio: Option<PathBuf>,
     /// Baud rate (the virtual board's design, or the port's).
     pub baud: u32,
 }
@@ -232,11 +246,11 @@ pub struct Played {
     pub clocks: Option<u64>,
 }
 
-/// Plays `script` on the board behind `link`: a session (PING, the board's format), the stop
-/// limits, the axis powered, the run. The stop-limit rule's warnings go to stderr.
-fn play_on<L: Link>(link: L, script: &Script) -> anyhow::Result<(RunReport, L)> {
+/// Plays `script` on the board behind `link` with the link's run options `run`: a session
+/// (PING, the board's format), the stop limits, the axis powered, the run. The stop-limit rule's warnings go to stderr.
+fn play_on<L: Link>(link: L, script: &Script, run: RunOptions) -> anyhow::Result<(RunReport, L)> {
     let mut session = Session::open(link, DEFAULT_FORMAT.position_lsb).map_err(failure)?;
-    let (report, _, warnings) = play_script(&mut session, &script.events, &script.options())
+    let (report, _, warnings) = play_script(&mut session, &script.events, &script.options(run))
         .map_err(|e| match e {
             PlayError::Setup(f) => failure(f),
             e => anyhow::Error::new(e),
@@ -249,10 +263,12 @@ fn play_on<L: Link>(link: L, script: &Script) -> anyhow::Result<(RunReport, L)> 
 
 /// Plays `script` on `target`.
 pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
-    if let Some(port) = &target.port {
-        let t = SerialTransport::open(port, target.baud)?;
+    if let Some((t, run)) =
+        crate::args::direct_link(target.port.as_deref(), target.uio.as_deref(), target.baud)
+            .map_err(failure)?
+    {
         let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
-        let (report, _) = play_on(link, &script)?;
+        let (report, _) = play_on(link, &script, run)?;
         return Ok(Played {
             report,
             script,
@@ -262,11 +278,26 @@ pub fn play(script: Script, target: &Target) -> anyhow::Result<Played> {
         });
     }
     let design = design(target.baud)?;
+    if matches!(target.board, BoardKind::AxiModel | BoardKind::AxiFabric) {
+        let board = match target.board {
+            BoardKind::AxiFabric => AxiBoard::lockstep(&design)?,
+            _ => AxiBoard::model(&design),
+        };
+        let (report, link) = play_on(axi_link(board)?, &script, RunOptions::memory_mapped())?;
+        let b = link.transport().registers();
+        return Ok(Played {
+            report,
+            script,
+            mismatches: (target.board == BoardKind::AxiFabric).then(|| b.mismatches()),
+            first_mismatch: b.first_mismatch().map(|m| m.to_string()),
+            clocks: Some(b.clocks()),
+        });
+    }
     let board = match target.board {
-        BoardKind::Model => VirtualBoard::model(&design),
         BoardKind::Fabric => VirtualBoard::lockstep(&design)?,
+        _ => VirtualBoard::model(&design),
     };
-    let (report, link) = play_on(board_link(board), &script)?;
+    let (report, link) = play_on(board_link(board), &script, RunOptions::default())?;
     let b = link.transport().board();
     let fabric = target.board == BoardKind::Fabric;
     Ok(Played {

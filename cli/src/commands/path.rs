@@ -26,7 +26,7 @@ use snapgen_host::path::board::{play_on_board_with, BoardError};
 use snapgen_host::path::group::MAX_EVENT_MS;
 use snapgen_host::path::group::STOP_MARGIN;
 use snapgen_host::path::{play_events, verify, PathAction, PathEvent, PathLimits, Run};
-use snapgen_host::serial::{session_seq, SerialTransport};
+use snapgen_host::serial::session_seq;
 use snapgen_host::session::Session;
 use snapgen_model::path::interp::Path;
 use snapgen_model::{Format, FRAC_BITS};
@@ -78,11 +78,15 @@ pub struct Args {
     /// length driving the interpolator and a step/dir generator per axis in fabric) with its
     /// model in lockstep, the axes read from its step lines. Without it (or `--port`) the
     /// host axis plays its own timeline, each change at the tick it is due.
-    #[arg(long, value_enum, conflicts_with = "port")]
+    #[arg(long, value_enum, conflicts_with_all = ["port", "uio"])]
     board: Option<PathBoard>,
     /// A real board's serial port instead.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "uio")]
     port: Option<String>,
+    /// A real board's station through its UIO device (`/dev/uioN`, on the board's own
+    /// processor: docs/AXI.md) instead.
+    #[arg(long)]
+    uio: Option<PathBuf>,
     /// Baud rate: the virtual board's UART (its design) or the port's.
     #[arg(long, default_value_t = 115_200)]
     baud: u32,
@@ -183,7 +187,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             return Err(InputError::Board(format!("{flag} {v}: give a positive number")).into());
         }
     }
-    let on_board = a.board.is_some() || a.port.is_some();
+    let on_board = a.board.is_some() || a.port.is_some() || a.uio.is_some();
     if on_board && a.ts.is_some() && a.board != Some(PathBoard::PathCore) {
         return Err(InputError::Board(
             "--ts: a board's tick is read from the board; leave --ts out".into(),
@@ -390,11 +394,20 @@ fn board_run(
     own: Option<PathLimits>,
     events: &[PathEvent],
 ) -> anyhow::Result<(Run, Format, Option<u64>)> {
-    if let Some(port) = &a.port {
-        let t = SerialTransport::open(port, a.baud)?;
+    if let Some((t, run)) = crate::args::direct_link(a.port.as_deref(), a.uio.as_deref(), a.baud)
+        .map_err(crate::error::failure)?
+    {
         let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
-        let (run, format, _) =
-            session_run(link, a.lsb, blocks, axes, own, events, |_, _, _| Ok(()))?;
+        let (run, format, _) = session_run(
+            link,
+            run,
+            a.lsb,
+            blocks,
+            axes,
+            own,
+            events,
+            |_, _, _| Ok(()),
+        )?;
         return Ok((run, format, None));
     }
     let design = crate::commands::online::design(a.baud)?;
@@ -415,12 +428,20 @@ fn board_run(
         let built = snapgen_sim::build::build_path_core(axes_n, false)?;
         let mut board = PathCoreBoard::open(&built.library, axes_n, &format)?;
         let link = path_core_link(&mut board, &format, f64::from(a.baud));
-        let (run, format, _) =
-            session_run(link, a.lsb, blocks, axes, own, events, |s, path, start| {
+        let (run, format, _) = session_run(
+            link,
+            RunOptions::default(),
+            a.lsb,
+            blocks,
+            axes,
+            own,
+            events,
+            |s, path, start| {
                 s.link
                     .lockstep()
                     .load_path(path, start, step, most_per_tick)
-            })?;
+            },
+        )?;
         let view = board.fabric_view();
         report_view(&view, &run, a.json);
         if view.differing > 0 || view.flags.is_some() || view.ticks == 0 {
@@ -436,6 +457,7 @@ fn board_run(
     };
     let (run, format, link) = session_run(
         board_link(board),
+        RunOptions::default(),
         a.lsb,
         blocks,
         axes,
@@ -476,10 +498,13 @@ fn report_view(v: &FabricView, run: &Run, json: bool) {
     }
 }
 
-/// A session on `link` (the board's format read, the axis at rest), the path played on it;
-/// `load` gives the board the path before anything moves (a board with the path core).
+/// A session on `link` (the board's format read, the axis at rest), the path played on it
+/// with the host's run options `run`; `load` gives the board the path before anything moves
+/// (a board with the path core).
+#[allow(clippy::too_many_arguments)]
 fn session_run<L: Link>(
     link: L,
+    run: RunOptions,
     lsb: f64,
     blocks: &[Block],
     axes: &[Limits],
@@ -488,23 +513,15 @@ fn session_run<L: Link>(
     load: impl FnOnce(&mut Session<L>, &Path, i128) -> Result<(), String>,
 ) -> anyhow::Result<(Run, Format, L)> {
     let mut session = Session::open(link, lsb).map_err(failure)?;
-    let (run, _, warnings) = play_on_board_with(
-        &mut session,
-        blocks,
-        axes,
-        own,
-        events,
-        RunOptions::default(),
-        load,
-    )
-    .map_err(|e| match e {
-        BoardError::Path(p) => InputError::Board(p.to_string()).into(),
-        BoardError::Load(why) => {
-            InputError::Board(format!("giving the board the path: {why}")).into()
-        }
-        BoardError::Board(ScriptError::Setup(f)) => failure(f),
-        e => anyhow::Error::new(e),
-    })?;
+    let (run, _, warnings) = play_on_board_with(&mut session, blocks, axes, own, events, run, load)
+        .map_err(|e| match e {
+            BoardError::Path(p) => InputError::Board(p.to_string()).into(),
+            BoardError::Load(why) => {
+                InputError::Board(format!("giving the board the path: {why}")).into()
+            }
+            BoardError::Board(ScriptError::Setup(f)) => failure(f),
+            e => anyhow::Error::new(e),
+        })?;
     for w in warnings {
         eprintln!("warning: {w}");
     }

@@ -6,7 +6,7 @@
 //! that instantiates them (`snapgen_path_steppers.v` and the three blocks' files), with
 //! `--path-core AXES` the motion core on the path length driving that stage
 //! (`snapgen_path_core.v` with the stage's files): issue 22's blocks, not yet in a board's
-//! design.
+//! design; with `--axi` the AXI4-Lite top (`snapgen_axi.v`, issue 23).
 
 use std::path::{Path, PathBuf};
 
@@ -44,6 +44,10 @@ pub struct Args {
     /// own: no design instantiates it yet).
     #[arg(long)]
     step_dir: bool,
+    /// Also write the AXI4-Lite top, `snapgen_axi.v`: the station of `snapgen_io.v` behind an
+    /// AXI4-Lite slave (register map: docs/AXI.md), for a host on a Zynq's ARM.
+    #[arg(long)]
+    axi: bool,
 }
 
 /// Runs the subcommand.
@@ -95,6 +99,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 .with_context(|| format!("cannot write {}", file.display()))?;
             println!("wrote {} ({axes} axes)", file.display());
         }
+    }
+    if a.axi {
+        let file = a
+            .out
+            .join(format!("{}.v", snapgen_hdl::axi_top::AXI_PREFIX));
+        std::fs::write(&file, snapgen_hdl::axi_top::axi_top_verilog(&d))
+            .with_context(|| format!("cannot write {}", file.display()))?;
+        println!(
+            "wrote {} (AXI4-Lite top; read it with {} and {})",
+            file.display(),
+            files.core.display(),
+            files.io_top.display()
+        );
     }
     if a.step_dir {
         let file = a

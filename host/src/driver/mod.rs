@@ -55,13 +55,33 @@ pub struct RunOptions {
     /// Longest run after the last event (ms) before the run ends with commands still busy
     /// (a held velocity).
     pub settle_ms: f64,
+    /// Ticks of lead a swap gets beyond its upload's estimate: the host's and the link's
+    /// timing jitter. A swap armed too late is refused (NAK LATE) and planned again with
+    /// twice the lead, so this trades latency against retries.
+    pub safety_ticks: u64,
 }
+
+/// The safety lead over a serial link: USB serial adapters and the host's scheduler.
+pub const SERIAL_SAFETY_TICKS: u64 = 20;
 
 impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             poll_ms: 2.0,
             settle_ms: 10_000.0,
+            safety_ticks: SERIAL_SAFETY_TICKS,
+        }
+    }
+}
+
+impl RunOptions {
+    /// Over a memory-mapped link (the station's AXI4-Lite registers): no wire and no adapter,
+    /// so the lead beyond the upload's estimate is the device's own minimum
+    /// ([`SWAP_MIN_LEAD`](snapgen_spec::rules::SWAP_MIN_LEAD)) and one tick.
+    pub fn memory_mapped() -> Self {
+        RunOptions {
+            safety_ticks: snapgen_spec::rules::SWAP_MIN_LEAD as u64 + 1,
+            ..Self::default()
         }
     }
 }
@@ -170,6 +190,7 @@ pub fn run<L: Link>(
         covered: first.ticks,
         extensions: 0,
         poll_ticks: ticks_of(opts.poll_ms, ts).max(1),
+        safety: opts.safety_ticks,
         polled: 0.0,
         reply_wire: 0.0,
         planning: 0,

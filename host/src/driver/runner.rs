@@ -33,9 +33,6 @@ pub(super) fn too_slow() -> RunError {
     }
 }
 
-/// Ticks of lead beyond the upload's estimate.
-pub(super) const SAFETY: u64 = 20;
-
 /// Bytes of `c`'s frame.
 pub(super) fn frame_bytes(c: &Command, f: &snapgen_model::format::Format) -> usize {
     c.to_frame(0, f).to_bytes().len()
@@ -105,6 +102,10 @@ pub(super) struct Runner<'l, L: Link> {
     pub(super) extensions: u32,
     /// Ticks between polls.
     pub(super) poll_ticks: u64,
+    /// Ticks of lead beyond an upload's estimate ([`RunOptions::safety_ticks`]).
+    ///
+    /// [`RunOptions::safety_ticks`]: super::RunOptions::safety_ticks
+    pub(super) safety: u64,
     /// The host's clock when the last READ_STATE's reply had come.
     pub(super) polled: f64,
     /// That reply's ticks on the wire.
@@ -574,9 +575,9 @@ impl<L: Link> Runner<'_, L> {
 
     /// The lead a swap of an upload of `n` segments is armed with: its time
     /// ([`Runner::upload_ticks`]) with a quarter more, times `margin` (doubled after each
-    /// NAK LATE), and [`SAFETY`].
+    /// NAK LATE), and the safety lead ([`Runner::safety`]).
     pub(super) fn lead(&self, n: usize, margin: f64) -> u64 {
-        (self.upload_ticks(n) * 1.25 * margin).ceil() as u64 + SAFETY
+        (self.upload_ticks(n) * 1.25 * margin).ceil() as u64 + self.safety
     }
 
     /// True when nothing will move any more without a new command.

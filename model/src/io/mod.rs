@@ -3,6 +3,7 @@
 //! the outputs after the rising edge, with exactly the hardware's rules, so that the HDL can be
 //! compared with it clock by clock.
 
+pub mod axi;
 pub mod config;
 pub mod executor;
 pub mod fifo;

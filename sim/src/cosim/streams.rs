@@ -146,6 +146,7 @@ pub(super) fn stream(
             // event (the stream's last events bring it to rest), at the latest 10^6 ticks on.
             poll_ms: 100.0 * spec.ts * 1e3,
             settle_ms: 1e6 * spec.ts * 1e3,
+            ..RunOptions::default()
         },
     };
     let mut session = match Session::open(link, f.position_lsb) {

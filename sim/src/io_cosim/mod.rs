@@ -28,7 +28,7 @@ use crate::fabric::VcdWindow;
 use crate::io::{encode_inputs, encode_outputs, FabricIo, IoSignal, IN_WORDS, OUT_WORDS};
 use crate::SimError;
 
-mod stream;
+pub(crate) mod stream;
 
 use stream::Stream;
 
@@ -180,7 +180,7 @@ pub struct IoCosimReport {
 }
 
 impl IoCosimReport {
-    fn bump(list: &mut Vec<(u8, u64)>, key: u8) {
+    pub(crate) fn bump(list: &mut Vec<(u8, u64)>, key: u8) {
         match list.iter_mut().find(|(k, _)| *k == key) {
             Some((_, n)) => *n += 1,
             None => {

@@ -149,24 +149,7 @@ impl Stream {
         let r = &mut self.rng;
         let ts = [1e-3, 1e-4][r.gen_range(0..2)];
         let f = Format::with_ts(ts);
-        let distance = log_uniform(r, 1e-6, 2e-2) * if r.gen_bool(0.5) { 1.0 } else { -1.0 };
-        let v = log_uniform(r, 0.01, 2.0);
-        let a = log_uniform(r, 0.5, 200.0);
-        let method = match r.gen_range(0..3) {
-            0 => Method::Order2 { vmax: v, amax: a },
-            1 => Method::Order3 {
-                vmax: v,
-                amax: a,
-                jmax: log_uniform(r, 5.0, 1e5),
-            },
-            _ => Method::Order4 {
-                vmax: v,
-                amax: a,
-                jmax: log_uniform(r, 5.0, 1e5),
-                dmax: log_uniform(r, 1e3, 1e8),
-            },
-        };
-        let req = MoveRequest { distance, method };
+        let req = random_move(r);
         let Ok(plan) = plan_from(&req, &f, dev.core().chain()) else {
             return;
         };
@@ -588,7 +571,7 @@ impl Stream {
 /// Stop limits (jerk, acceleration), raw, for moves like the stream's (planned at Ts = 1 ms):
 /// mostly valid, now and then invalid (jerk above acceleration, or zero: POWER is then
 /// refused).
-fn stop_limits(r: &mut StdRng) -> (i128, i128) {
+pub(crate) fn stop_limits(r: &mut StdRng) -> (i128, i128) {
     let g = Format::with_ts(1e-3);
     let accel = (log_uniform(r, 0.5, 500.0) * g.scale(Quantity::Acceleration)) as i128;
     let jerk = (log_uniform(r, 5.0, 1e5) * g.scale(Quantity::Jerk)) as i128;
@@ -599,8 +582,31 @@ fn stop_limits(r: &mut StdRng) -> (i128, i128) {
     }
 }
 
+/// A short move of order 2, 3 or 4 with random limits (distances 1 µm–20 mm of either sign at
+/// 1 ms or 0.1 ms a tick: a few thousand ticks at most).
+pub(crate) fn random_move(r: &mut StdRng) -> MoveRequest {
+    let distance = log_uniform(r, 1e-6, 2e-2) * if r.gen_bool(0.5) { 1.0 } else { -1.0 };
+    let v = log_uniform(r, 0.01, 2.0);
+    let a = log_uniform(r, 0.5, 200.0);
+    let method = match r.gen_range(0..3) {
+        0 => Method::Order2 { vmax: v, amax: a },
+        1 => Method::Order3 {
+            vmax: v,
+            amax: a,
+            jmax: log_uniform(r, 5.0, 1e5),
+        },
+        _ => Method::Order4 {
+            vmax: v,
+            amax: a,
+            jmax: log_uniform(r, 5.0, 1e5),
+            dmax: log_uniform(r, 1e3, 1e8),
+        },
+    };
+    MoveRequest { distance, method }
+}
+
 /// Any command with random arguments (good and bad).
-fn random_command(r: &mut StdRng, f: &Format, ticks: u64) -> Command {
+pub(crate) fn random_command(r: &mut StdRng, f: &Format, ticks: u64) -> Command {
     let n = snapgen_spec::PARAMS.len() as u8;
     let param = Param::from_byte(r.gen_range(1..=n)).expect("1..=n are parameters");
     match r.gen_range(0..13) {

@@ -49,7 +49,7 @@ impl From<UnknownConstant> for DocError {
 }
 
 /// Every block a page may mark.
-pub const BLOCKS: [&str; 14] = [
+pub const BLOCKS: [&str; 15] = [
     "commands",
     "refusals",
     "states",
@@ -64,10 +64,11 @@ pub const BLOCKS: [&str; 14] = [
     "config",
     "examples",
     "board_pins",
+    "axi_registers",
 ];
 
 /// The pages under docs/ with generated blocks.
-pub const PAGES: [&str; 2] = ["PROTOCOL.md", "BOARDS.md"];
+pub const PAGES: [&str; 3] = ["PROTOCOL.md", "BOARDS.md", "AXI.md"];
 
 fn row(cells: &[String]) -> String {
     format!("| {} |\n", cells.join(" | "))
@@ -269,6 +270,10 @@ pub fn block(name: &str, extra: &[(&str, String)]) -> Result<String, DocError> {
                 .collect::<Result<Vec<_>, DocError>>()?;
             table(&["port", "direction", "I/O top port", "what"], rows)
         }
+        "axi_registers" => table(
+            &["offset", "register", "words", "access", "reset", "meaning"],
+            crate::emit::axi::markdown_table(),
+        ),
         other => return Err(DocError::UnknownBlock(other.to_string())),
     })
 }

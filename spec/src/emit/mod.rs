@@ -1,7 +1,9 @@
 //! What the contract is written out as: the tables of docs/PROTOCOL.md ([`markdown`], with
 //! the worked [`examples`]), a C header ([`c_header`]), a JSON description ([`json`]) and
-//! Verilog `localparam`s ([`verilog`]). `snapgen spec --emit DIR` writes the first three.
+//! Verilog `localparam`s ([`verilog`]); the AXI4-Lite register map as a C header and JSON
+//! ([`axi`]). `snapgen spec --emit DIR` writes all but the Verilog.
 
+pub mod axi;
 pub mod c_header;
 pub mod examples;
 pub mod json;
@@ -9,10 +11,12 @@ pub mod markdown;
 pub mod verilog;
 
 /// The files [`files`] writes.
-pub const FILE_NAMES: [&str; 3] = [
+pub const FILE_NAMES: [&str; 5] = [
     "snapgen_protocol.h",
     "snapgen_protocol.json",
     "snapgen_protocol_tables.md",
+    "snapgen_axi.h",
+    "snapgen_axi.json",
 ];
 
 /// Every generated file for users' firmware and tools: name and contents (`extra`: facts of
@@ -33,5 +37,10 @@ pub fn files(extra: &[(&str, String)]) -> Result<Vec<(&'static str, String)>, ma
             serde_json::to_string_pretty(&json).expect("a JSON value serialises") + "\n",
         ),
         (FILE_NAMES[2], md),
+        (FILE_NAMES[3], axi::c_header()),
+        (
+            FILE_NAMES[4],
+            serde_json::to_string_pretty(&axi::json()).expect("a JSON value serialises") + "\n",
+        ),
     ])
 }
