@@ -33,6 +33,9 @@ pub trait Registers {
     fn access_time(&self) -> f64;
 }
 
+/// Most reply bytes one [`Transport::read`] takes.
+const MAX_READ: usize = 512;
+
 /// The command stream over a station's registers.
 pub struct RegisterTransport<R> {
     regs: R,
@@ -119,10 +122,20 @@ impl<R: Registers> Transport for RegisterTransport<R> {
             let v = self.regs.read(offset_of("REPLY"))?;
             if v & REPLY_VALID != 0 {
                 out.push(v as u8);
+                // A bounded take: a fast telemetry stream must not keep the host here.
+                if out.len() - before >= MAX_READ {
+                    return Ok(());
+                }
                 continue;
             }
             let left = deadline - self.regs.now();
-            if out.len() > before || left <= 0.0 || !self.regs.wait_irq(left)? {
+            if out.len() > before || left <= 0.0 {
+                return Ok(());
+            }
+            if !self.regs.wait_irq(left)? {
+                // Nothing came: take the interrupt again, in case the station was reset
+                // meanwhile (its IRQ_ENABLE cleared).
+                self.regs.write(offset_of("IRQ_ENABLE"), IRQ_REPLY)?;
                 return Ok(());
             }
         }
@@ -144,13 +157,22 @@ impl<R: Registers> Transport for RegisterTransport<R> {
 /// A Linux UIO device (`/dev/uioN`) bound to the station: its first map `mmap`ed, the
 /// interrupt waited for by `read` (re-armed by writing 1, as the `uio_pdrv_genirq` driver
 /// expects). The device-tree node and the steps on the board: docs/AXI.md.
+///
+/// The device is locked for this host alone (`flock`): a second `snapgen` on the same station
+/// would mix its bytes into this one's frames. Without an interrupt in the device tree (the
+/// unmask write fails), replies are polled every [`POLL_S`] instead.
 #[cfg(target_os = "linux")]
 pub struct Uio {
-    file: std::fs::File,
+    file: nix::fcntl::Flock<std::fs::File>,
     base: std::ptr::NonNull<u32>,
     len: usize,
     start: std::time::Instant,
+    irq: bool,
 }
+
+/// The poll period of a UIO device without an interrupt (s).
+#[cfg(target_os = "linux")]
+pub const POLL_S: f64 = 50e-6;
 
 #[cfg(target_os = "linux")]
 impl Uio {
@@ -168,6 +190,13 @@ impl Uio {
             .write(true)
             .open(path)
             .map_err(|e| io("cannot open the UIO device (is the uio_pdrv_genirq driver bound to the station's node? docs/AXI.md)", &e))?;
+        let file = nix::fcntl::Flock::lock(file, nix::fcntl::FlockArg::LockExclusiveNonblock)
+            .map_err(|(_, e)| {
+                io(
+                    "another host holds the station (its UIO device is locked)",
+                    &e,
+                )
+            })?;
         let len = map_size(path).unwrap_or(4096).max(SPAN as usize);
         let len_nz = NonZeroUsize::new(len).expect("the map spans bytes");
         // SAFETY: a shared mapping of the device's registers, the whole of its first map;
@@ -178,25 +207,30 @@ impl Uio {
                 len_nz,
                 ProtFlags::PROT_READ | ProtFlags::PROT_WRITE,
                 MapFlags::MAP_SHARED,
-                &file,
+                &*file,
                 0,
             )
         }
         .map_err(|e| io("cannot map its registers", &e))?;
-        Ok(Uio {
+        let mut uio = Uio {
             file,
             base: ptr.cast(),
             len,
             start: std::time::Instant::now(),
-        })
+            irq: true,
+        };
+        // An interrupt to unmask, or polling.
+        uio.irq = std::io::Write::write_all(&mut *uio.file, &1u32.to_ne_bytes()).is_ok();
+        Ok(uio)
     }
 
     fn word(&self, offset: u32) -> Result<*mut u32, LinkError> {
         let at = offset as usize;
-        if at % 4 != 0 || at + 4 > self.len {
+        // Within the register map (the slave decodes 8 address bits: past it, an access would
+        // reach a register again) and the mapping.
+        if at % 4 != 0 || at + 4 > (SPAN as usize).min(self.len) {
             return Err(LinkError::Io(format!(
-                "register offset {offset:#x} outside the UIO map ({} bytes)",
-                self.len
+                "register offset {offset:#x} outside the station's map ({SPAN:#x} bytes)"
             )));
         }
         // SAFETY: within the mapping (checked above), word-aligned.
@@ -231,20 +265,29 @@ impl Registers for Uio {
         use std::io::{Read, Write};
         use std::os::fd::AsFd;
 
+        use nix::errno::Errno;
         use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
 
+        if !self.irq {
+            // No interrupt: look again after a poll period.
+            self.sleep(seconds.min(POLL_S));
+            return Ok(true);
+        }
         let err = |e: &dyn std::fmt::Display| LinkError::Io(format!("UIO interrupt: {e}"));
         // Unmask the interrupt, then wait for it.
         self.file
             .write_all(&1u32.to_ne_bytes())
             .map_err(|e| err(&e))?;
         let ms = (seconds * 1e3).ceil().clamp(0.0, f64::from(i32::MAX)) as i32;
-        let mut fds = [PollFd::new(self.file.as_fd(), PollFlags::POLLIN)];
-        let n = poll(
-            &mut fds,
-            PollTimeout::try_from(ms).unwrap_or(PollTimeout::MAX),
-        )
-        .map_err(|e| err(&e))?;
+        let timeout = PollTimeout::try_from(ms).unwrap_or(PollTimeout::MAX);
+        let n = loop {
+            let mut fds = [PollFd::new(self.file.as_fd(), PollFlags::POLLIN)];
+            match poll(&mut fds, timeout) {
+                // A signal: wait again (the caller's deadline bounds the whole).
+                Err(Errno::EINTR) => continue,
+                r => break r.map_err(|e| err(&e))?,
+            }
+        };
         if n == 0 {
             return Ok(false);
         }

@@ -139,6 +139,21 @@ pub const IRQ_FIELDS: [BitField; 4] = [
         doc: "a reply byte waits in REPLY (a level: it clears when the replies are read; writing it does nothing)",
     },
 ];
+/// `IRQ_ENABLE`'s fields: one enable per cause, at the cause's bit of `IRQ_STATUS`.
+pub const IRQ_ENABLE_FIELDS: [BitField; 4] = [
+    enable(IRQ_FIELDS[0], "DONE raises irq"),
+    enable(IRQ_FIELDS[1], "FAULT raises irq"),
+    enable(IRQ_FIELDS[2], "SWAP raises irq"),
+    enable(
+        IRQ_FIELDS[3],
+        "REPLY raises irq (the host's UIO link enables this one alone)",
+    ),
+];
+
+const fn enable(cause: BitField, doc: &'static str) -> BitField {
+    BitField { doc, ..cause }
+}
+
 /// `IRQ_STATUS`/`IRQ_ENABLE` bit: a program ran to its end.
 pub const IRQ_DONE: u32 = 1 << IRQ_FIELDS[0].lsb;
 /// `IRQ_STATUS`/`IRQ_ENABLE` bit: the axis entered ErrorStop.
@@ -251,7 +266,7 @@ pub const REGISTERS: [Register; 14] = [
         words: 1,
         access: Access::ReadWrite,
         reset: 0,
-        fields: &IRQ_FIELDS,
+        fields: &IRQ_ENABLE_FIELDS,
         snap: None,
         doc: "the causes that raise `irq` (bits as IRQ_STATUS)",
     },

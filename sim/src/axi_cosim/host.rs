@@ -71,13 +71,13 @@ impl Host {
 
     fn bytes(&mut self, bytes: &[u8]) {
         for &b in bytes {
-            // The unused lanes carry noise; lane 0 is strobed.
+            // The unused lanes carry noise; lane 0 is strobed (now and then not: the byte is
+            // not taken, and the frame is damaged).
             let noise = self.rng.gen::<u32>() & !0xFF;
-            self.master.write(
-                offset_of("COMMAND"),
-                noise | u32::from(b),
-                1 | self.rng.gen_range(0..16),
-            );
+            let lane0 = u8::from(!self.rng.gen_bool(0.002));
+            let strb = lane0 | (self.rng.gen_range(0..16) & !1);
+            self.master
+                .write(offset_of("COMMAND"), noise | u32::from(b), strb);
         }
     }
 
@@ -183,7 +183,9 @@ impl Host {
                 }
                 self.release = Some(self.now + self.rng.gen_range(5..300));
             }
-            89..=92 => self.send(Command::Reset),
+            89..=91 => self.send(Command::Reset),
+            // The reset pin, with transactions in flight: the slave forgets them.
+            92 => self.peer.reset_clocks = self.rng.gen_range(1..4),
             _ => {
                 let value = [15, 7, 40][self.rng.gen_range(0..3)];
                 self.send(Command::Configure {
@@ -205,6 +207,12 @@ impl Host {
             self.peer.limit_negative = false;
         }
         let pins = self.peer.inputs();
+        if pins.reset {
+            // A reset ends every transaction, queued or in flight, and any frame half read.
+            self.master.abort();
+            self.decoder = Decoder::new();
+            self.report.resets += 1;
+        }
         if !pins.reset {
             if self.now < 20 {
                 // First a short tick, so that moves take few clocks.

@@ -95,6 +95,16 @@ impl AxiMaster {
         self.reads.push_back(addr as u8);
     }
 
+    /// Drops every transaction, queued or in flight (a reset: the slave forgets them).
+    pub fn abort(&mut self) {
+        self.writes.clear();
+        self.reads.clear();
+        self.write = None;
+        self.read = None;
+        self.write_wait.clear();
+        self.read_wait.clear();
+    }
+
     /// Writes queued or in flight.
     pub fn writes_pending(&self) -> usize {
         self.writes.len() + usize::from(self.write.is_some()) + self.write_wait.len()

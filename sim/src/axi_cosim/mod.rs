@@ -64,6 +64,8 @@ pub struct AxiCosimReport {
     pub swaps_armed: u64,
     /// Snapshots taken and read.
     pub snapshots: u64,
+    /// Clocks with the reset pin high.
+    pub resets: u64,
     /// Every IRQ_STATUS bit seen set by a read.
     pub irq_seen: u32,
     /// Clocks with `irq` high.
