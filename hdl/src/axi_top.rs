@@ -14,8 +14,9 @@ use snapgen_model::device::Design;
 use snapgen_model::io::axi::AxiDevice;
 use snapgen_model::ports::{AxiInputs, AxiOutputs};
 use snapgen_spec::axi::{
-    offset, Access, ADDR_BITS, IRQ_DONE, IRQ_FAULT, IRQ_REPLY, IRQ_SWAP, REGISTERS, RESP_OKAY,
-    RESP_SLVERR, STATUS_DONE_BIT, STATUS_STATE_LSB, STATUS_SWAP_PENDING_BIT,
+    offset, Access, ADDR_BITS, COMMAND_FIELDS, IRQ_DONE, IRQ_FAULT, IRQ_REPLY, IRQ_SWAP, REGISTERS,
+    REPLY_FIELDS, REPLY_VALID, RESP_OKAY, RESP_SLVERR, STATUS_DONE_BIT, STATUS_STATE_LSB,
+    STATUS_SWAP_PENDING_BIT,
 };
 use snapgen_spec::ports::{Dir, Port, AXI_TOP, STATION};
 use snapgen_spec::AxisState;
@@ -37,6 +38,15 @@ const STATION_MODULE: &str = "snapgen_io_station";
 
 // The template's IRQ_STATUS is {REPLY, latched causes}: the causes' bits as the spec's.
 const _: () = assert!(IRQ_DONE == 1 && IRQ_FAULT == 2 && IRQ_SWAP == 4 && IRQ_REPLY == 8);
+// The template's REPLY read is {23'd0, 1'b1, byte} and a COMMAND write takes bits 7:0: the
+// fields as the spec's.
+const _: () = assert!(
+    REPLY_FIELDS[0].lsb == 0
+        && REPLY_FIELDS[0].bits == 8
+        && REPLY_VALID == 1 << 8
+        && COMMAND_FIELDS[0].lsb == 0
+        && COMMAND_FIELDS[0].bits == 8
+);
 
 /// Lint waivers of the AXI top: the address bits and byte lanes the slave does not decode.
 pub const WAIVERS: [Waiver; 4] = [
