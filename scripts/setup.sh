@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what snapgen's demo and tests need beside Rust, when it is missing: Verilator (the
-# co-simulation and the lint), Yosys (synthesis) and Python's venv (for the routed-timing
+# co-simulation and the lint), Yosys (synthesis), tclsh and dtc (the Zynq build's checks) and
+# Python's venv (for the routed-timing
 # check's nextpnr from PyPI), with apt-get (as root, or through sudo).
 # Sourced by scripts/demo.sh and scripts/test.sh; safe to run again (installs nothing twice).
 set -euo pipefail
@@ -12,6 +13,10 @@ fi
 need_apt=()
 command -v verilator >/dev/null 2>&1 || need_apt+=(verilator)
 command -v yosys >/dev/null 2>&1 || need_apt+=(yosys)
+# The Zynq build's checks: its Vivado scripts run under a stand-in in tclsh, its device-tree
+# overlay is compiled with dtc.
+command -v tclsh >/dev/null 2>&1 || need_apt+=(tcl)
+command -v dtc >/dev/null 2>&1 || need_apt+=(device-tree-compiler)
 # Python with venv and pip: scripts/route.sh installs nextpnr-ecp5 from PyPI into a venv.
 if ! command -v python3 >/dev/null 2>&1; then
   need_apt+=(python3 python3-venv)

@@ -174,6 +174,27 @@ pub struct Board {
     /// Pins driven to a constant level (optional).
     #[serde(default)]
     pub ties: Vec<Tie>,
+    /// The processing system of a Zynq board (optional): what `snapgen build --host ps` needs.
+    #[serde(default)]
+    pub ps: Option<ProcessingSystem>,
+}
+
+/// A Zynq-7000 board's processing system, for the build in which its ARM is the host over
+/// AXI4-Lite (`snapgen build --host ps`, [`crate::zynq`]).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProcessingSystem {
+    /// Vivado's board part (the board vendor's board files, which hold the PS7's DDR and MIO
+    /// preset), e.g. `digilentinc.com:zybo-z7-10:part0:1.0`.
+    pub board_part: String,
+    /// The PS's IO PLL frequency under that preset (Hz): FCLK_CLK0 is it divided by two
+    /// dividers of 1 to 63.
+    pub io_pll_hz: u64,
+    /// The fabric clock, FCLK_CLK0 (Hz): an exact division of `io_pll_hz`.
+    pub fclk_hz: u64,
+    /// The snapgen slave's base address on M_AXI_GP0 (0x4000_0000 to 0x7FFF_F000, 4 KiB
+    /// aligned).
+    pub axi_base: u64,
 }
 
 /// A board description that cannot be used, with what to change.
@@ -402,6 +423,9 @@ impl Board {
                 return Err(bad("clock.pll_hz", &pll, &e.to_string()));
             }
         }
+        if let Some(ps) = &self.ps {
+            self.check_ps(ps, &bad)?;
+        }
         let mut pins: BTreeMap<&str, &str> = BTreeMap::new();
         let mut ports: BTreeMap<&str, Direction> = BTreeMap::new();
         let claim = |pin: &str, iostandard: &str, field: &str| {
@@ -514,11 +538,74 @@ impl Board {
         }
         Ok(())
     }
+
+    fn check_ps(
+        &self,
+        ps: &ProcessingSystem,
+        bad: &dyn Fn(&str, &dyn std::fmt::Display, &str) -> BoardError,
+    ) -> Result<(), BoardError> {
+        if self.family != "xc7" || !self.device.starts_with("xc7z") {
+            return Err(bad(
+                "ps",
+                &self.device,
+                "a [ps] table is for Zynq-7000 boards (family \"xc7\", device xc7z...): remove it",
+            ));
+        }
+        if ps.board_part.split(':').count() != 4 {
+            return Err(bad(
+                "ps.board_part",
+                &ps.board_part,
+                "give Vivado's board part, vendor:board:part0:version (e.g. digilentinc.com:zybo-z7-10:part0:1.0)",
+            ));
+        }
+        if crate::zynq::fclk_dividers(ps.io_pll_hz, ps.fclk_hz).is_none() {
+            return Err(bad(
+                "ps.fclk_hz",
+                &ps.fclk_hz,
+                &format!(
+                    "the PS makes FCLK_CLK0 as io_pll_hz ({}) divided by two dividers of 1 to 63: give such a frequency (e.g. {})",
+                    ps.io_pll_hz,
+                    ps.io_pll_hz / 10
+                ),
+            ));
+        }
+        if !crate::zynq::GP0_WINDOW.contains(&ps.axi_base)
+            || ps.axi_base % crate::zynq::UIO_SPAN != 0
+        {
+            return Err(bad(
+                "ps.axi_base",
+                &format!("{:#x}", ps.axi_base),
+                "give a 4 KiB aligned address in M_AXI_GP0's window, 0x40000000 to 0x7ffff000 (e.g. 0x43c00000)",
+            ));
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fclk_is_made_by_two_dividers() {
+        assert_eq!(
+            crate::zynq::fclk_dividers(1_000_000_000, 100_000_000),
+            Some((1, 10))
+        );
+        assert_eq!(
+            crate::zynq::fclk_dividers(1_000_000_000, 125_000_000),
+            Some((1, 8))
+        );
+        // 4000 > 63 x 63: no pair of 6-bit dividers.
+        assert_eq!(crate::zynq::fclk_dividers(1_000_000_000, 250_000), None);
+        // 64 = 2 x 32 (one divider alone cannot make 64).
+        assert_eq!(
+            crate::zynq::fclk_dividers(1_000_000_000, 15_625_000),
+            Some((2, 32))
+        );
+        assert_eq!(crate::zynq::fclk_dividers(1_000_000_000, 123_000_000), None);
+        assert_eq!(crate::zynq::fclk_dividers(1_000_000_000, 0), None);
+    }
 
     #[test]
     fn the_builtin_board_is_valid() {
@@ -534,7 +621,7 @@ mod tests {
     #[test]
     fn mistakes_are_named_with_what_to_change() {
         type Edit<'a> = &'a dyn Fn(&str) -> String;
-        let cases: [(Edit, &str); 8] = [
+        let cases: [(Edit, &str); 12] = [
             (
                 &|t| t.replace("name = \"zybo-z7-10\"", "name = \"Zybo Z7\""),
                 "name = \"Zybo Z7\"",
@@ -572,6 +659,19 @@ mod tests {
                 &|t| t.replace("[resources]\n", "[resources]\nluts_x = 1\n"),
                 "unknown field `luts_x`",
             ),
+            (
+                &|t| t.replace("fclk_hz = 100000000", "fclk_hz = 123000000"),
+                "ps.fclk_hz = \"123000000\": the PS makes FCLK_CLK0",
+            ),
+            (
+                &|t| t.replace("axi_base = 0x43C00000", "axi_base = 0x43C00100"),
+                "ps.axi_base = \"0x43c00100\": give a 4 KiB aligned address",
+            ),
+            (
+                &|t| t.replace("axi_base = 0x43C00000", "axi_base = 0x80000000"),
+                "M_AXI_GP0's window",
+            ),
+            (&|t| t.replace(":part0:1.2", ""), "ps.board_part"),
         ];
         for (edit, want) in cases {
             let e = zybo_with(edit).unwrap_err().to_string();
@@ -589,8 +689,13 @@ mod tests {
             (25_000_000, 75_000_000)
         );
         let ulx3s = BUILTIN[1].1;
-        let cases: [(String, &str); 6] = [
+        let ps = &BUILTIN[0].1[BUILTIN[0].1.find("\n[ps]").unwrap()..];
+        let cases: [(String, &str); 7] = [
             (ulx3s.replace("level = 1", "level = 2"), "give 0 or 1"),
+            (
+                format!("{ulx3s}{ps}"),
+                "a [ps] table is for Zynq-7000 boards",
+            ),
             (
                 ulx3s.replace("port = \"wifi_gpio0\"", "port = \"pwm\""),
                 "not a port of the board top",

@@ -10,6 +10,7 @@
 //!   Xilinx cell library with its specify blocks; routing delay is not included).
 
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -19,7 +20,7 @@ use snapgen_model::timing::Timing;
 
 use snapgen_spec::ports::{board_pins, Dir, PinUse, BOARD_CLOCK, BOARD_RESET, IO_TOP};
 
-use crate::board_spec::{Board, Toolchain};
+use crate::board_spec::{Board, Pin, Toolchain};
 
 /// The board top: clock, power-on and button reset synchronised to the clock, the I/O top. Its
 /// ports and their wiring are the spec's board pins (`snapgen_spec::ports::board_pins`): a pin
@@ -180,19 +181,10 @@ pub fn xdc(b: &Board, timing: &Timing) -> String {
         b.clock.port
     );
     for p in &b.pins {
-        s.push_str(&format!(
-            "set_property -dict {{ PACKAGE_PIN {} IOSTANDARD {} }} [get_ports {{ {} }}] ;# {} ({})\n",
-            p.pin, p.iostandard, p.port, p.comment, p.direction.name()
-        ));
-        let pull = match p.pull {
-            Some(crate::board_spec::Pull::Up) => "PULLUP",
-            Some(crate::board_spec::Pull::Down) => "PULLDOWN",
-            Some(crate::board_spec::Pull::None) => "NONE",
-            None => continue,
-        };
-        s.push_str(&format!(
-            "set_property PULLTYPE {pull} [get_ports {{ {} }}]\n",
-            p.port
+        s.push_str(&xdc_pin(
+            &p.port,
+            p,
+            &format!("{} ({})", p.comment, p.direction.name()),
         ));
     }
     for t in &b.ties {
@@ -201,6 +193,22 @@ pub fn xdc(b: &Board, timing: &Timing) -> String {
             t.pin, t.iostandard, t.port, t.comment, t.level
         ));
     }
+    s
+}
+
+/// One constraint line: a port on its package pin with its I/O standard and pull.
+pub fn xdc_pin(port: &str, pin: &Pin, what: &str) -> String {
+    let mut s = format!(
+        "set_property -dict {{ PACKAGE_PIN {} IOSTANDARD {} }} [get_ports {{ {port} }}] ;# {what}\n",
+        pin.pin, pin.iostandard
+    );
+    let pull = match pin.pull {
+        Some(crate::board_spec::Pull::Up) => "PULLUP",
+        Some(crate::board_spec::Pull::Down) => "PULLDOWN",
+        Some(crate::board_spec::Pull::None) => "NONE",
+        None => return s,
+    };
+    let _ = writeln!(s, "set_property PULLTYPE {pull} [get_ports {{ {port} }}]");
     s
 }
 

@@ -16,6 +16,7 @@ mod report;
 mod scenario;
 mod svg;
 mod yosys;
+mod zynq;
 
 use std::process::ExitCode;
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 mod common;
-use common::{assert_ok, snapgen};
+use common::{assert_ok, lint_clean, snapgen};
 
 fn tmp(name: &str) -> PathBuf {
     common::tmp("fpga", name)
@@ -65,21 +65,6 @@ fn build_writes_a_complete_vivado_build() {
     assert!(tcl.contains("set part xc7z010clg400-1"));
     assert!(read("Makefile").contains("VIVADO ?= vivado"));
     assert!(read("snapgen_io.v").contains("module snapgen_io("));
-}
-
-/// Runs `verilator --lint-only -Wall` on `files` with top `top`: no warning, no error.
-fn lint_clean(dir: &std::path::Path, top: &str, files: &[String]) {
-    let lint = Command::new("verilator")
-        .current_dir(dir)
-        .args(["--lint-only", "-Wall", "--top-module", top])
-        .args(files)
-        .output()
-        .expect("verilator is installed by the test command");
-    let text = String::from_utf8_lossy(&lint.stderr);
-    assert!(
-        lint.status.success() && !text.contains("%Warning"),
-        "{top}: {text}"
-    );
 }
 
 /// Every file snapgen generates — the core, the I/O top and a board build, here for another

@@ -1,7 +1,8 @@
 //! `snapgen build`: a board build written for a board — board top, I/O top, motion core and
 //! the toolchain's files. An ECP5 board's open flow (Yosys, nextpnr-ecp5, ecppack) runs here
 //! and writes the `.bit`, failing when routed timing does not close (`--files-only` skips it);
-//! a Xilinx board's Vivado build (XDC, TCL, Makefile) runs with `--run`.
+//! a Xilinx board's Vivado build (XDC, TCL, Makefile) runs with `--run`. With `--host ps` a
+//! Zynq board's build is the one in which its ARM is the host over AXI4-Lite ([`crate::zynq`]).
 
 use std::path::PathBuf;
 
@@ -23,16 +24,40 @@ pub struct Args {
     /// Write an ECP5 board's files only, without running its flow.
     #[arg(long)]
     files_only: bool,
+    /// Where the host runs: `uart`, a PC on the fabric's UART (the UART top); `ps`, the Zynq's
+    /// own ARM over AXI4-Lite (the AXI top in a Vivado block design with the PS7, a device-tree
+    /// overlay for the UIO driver; boards with a [ps] table).
+    #[arg(long, value_enum, default_value = "uart")]
+    host: Host,
     #[command(flatten)]
     timing: TimingArgs,
+}
+
+/// Where the host runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Host {
+    /// A PC on the fabric's UART.
+    Uart,
+    /// The Zynq's processing system, over AXI4-Lite.
+    Ps,
 }
 
 /// Runs the subcommand.
 pub fn run(a: Args) -> anyhow::Result<()> {
     let b = a.board.load()?;
-    let (t, d) = a
-        .timing
-        .resolve(Some(b.fabric_clock_hz()), b.input_polarity)?;
+    let ps = match (a.host, &b.ps) {
+        (Host::Uart, _) => None,
+        (Host::Ps, Some(ps)) => Some(ps),
+        (Host::Ps, None) => {
+            return Err(crate::error::InputError::Board(format!(
+                "--host ps: the {} has no processing system (no [ps] table in its board file): use a Zynq board, e.g. --board zybo-z7-10, or drop --host ps",
+                b.name
+            ))
+            .into())
+        }
+    };
+    let clock = ps.map_or(b.fabric_clock_hz(), |ps| ps.fclk_hz);
+    let (t, d) = a.timing.resolve(Some(clock), b.input_polarity)?;
     let run = match (b.toolchain(), a.run, a.files_only) {
         (Toolchain::Vivado, _, true) => {
             return Err(crate::error::InputError::Board(format!(
@@ -51,8 +76,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (Toolchain::Vivado, run, _) => run,
         (Toolchain::OpenEcp5, _, files_only) => !files_only,
     };
-    let out = a.out.unwrap_or_else(|| PathBuf::from("out").join(&b.name));
-    let plan = crate::fpga::build_plan(&b, &t, &d)?;
+    let out = a.out.unwrap_or_else(|| {
+        PathBuf::from("out").join(match ps {
+            Some(_) => format!("{}-ps", b.name),
+            None => b.name.clone(),
+        })
+    });
+    let plan = match ps {
+        Some(ps) => crate::zynq::build_plan(&b, ps, &t, &d)?,
+        None => crate::fpga::build_plan(&b, &t, &d)?,
+    };
     for f in plan.write(&out)? {
         println!("wrote {}", f.display());
     }

@@ -35,3 +35,18 @@ pub fn tmp(group: &str, name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
+
+/// Runs `verilator --lint-only -Wall` on `files` with top `top`: no warning, no error.
+pub fn lint_clean(dir: &std::path::Path, top: &str, files: &[String]) {
+    let lint = Command::new("verilator")
+        .current_dir(dir)
+        .args(["--lint-only", "-Wall", "--top-module", top])
+        .args(files)
+        .output()
+        .expect("verilator is installed by the test command");
+    let text = String::from_utf8_lossy(&lint.stderr);
+    assert!(
+        lint.status.success() && !text.contains("%Warning"),
+        "{top}: {text}"
+    );
+}

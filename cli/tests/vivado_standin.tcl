@@ -1,0 +1,49 @@
+# A stand-in for Vivado's Tcl commands, for running snapgen's generated Vivado scripts where
+# Vivado is not installed (cli/tests/zynq.rs). It is not a model of Vivado: every command that
+# tclsh does not know is recorded (one line per call on stdout: "CALL", the words, separated by
+# the unit separator \x1f) and answers with a placeholder object, except the few queries whose
+# answers steer the scripts, which answer what the environment says:
+#
+#   STANDIN_BOARD_PARTS   get_board_parts (default: the part asked for)
+#   STANDIN_FCLK_MHZ      get_property CONFIG.PCW_ACT_FPGA0_PERIPHERAL_FREQMHZ (default 100.000000)
+#   STANDIN_SLACK         get_property SLACK (default 0.250)
+#   STANDIN_PROGRESS      get_property PROGRESS (default 100%)
+#
+# Usage: tclsh vivado_standin.tcl SCRIPT
+# Runs SCRIPT as Vivado would source it; the exit status is 1, with the error on stderr, when
+# the script raises an error.
+
+proc standin_env {name default} {
+    if {[info exists ::env($name)]} { return $::env($name) }
+    return $default
+}
+
+proc unknown {cmd args} {
+    puts [join [concat [list CALL $cmd] $args] "\x1f"]
+    switch -- $cmd {
+        get_board_parts {
+            set asked [lindex $args end]
+            return [standin_env STANDIN_BOARD_PARTS $asked]
+        }
+        get_property {
+            switch -- [lindex $args 0] {
+                CONFIG.PCW_ACT_FPGA0_PERIPHERAL_FREQMHZ { return [standin_env STANDIN_FCLK_MHZ 100.000000] }
+                SLACK { return [standin_env STANDIN_SLACK 0.250] }
+                PROGRESS { return [standin_env STANDIN_PROGRESS 100%] }
+            }
+            return "<property [lindex $args 0]>"
+        }
+        make_wrapper { return "/standin/wrapper.v" }
+        get_bd_pins - get_bd_ports - get_bd_intf_pins - get_bd_cells - get_ports {
+            # An object that names what was asked for, so that a connection shows its ends.
+            return "<$cmd:[join [concat {*}$args] ,]>"
+        }
+    }
+    return "<$cmd>"
+}
+
+if {[catch {source [lindex $argv 0]} message]} {
+    puts stderr $message
+    exit 1
+}
+exit 0
