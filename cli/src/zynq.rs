@@ -36,6 +36,8 @@ pub const IP_VLNV: [&str; 4] = ["snapgen.dev", "snapgen", "snapgen_axi", "1.0"];
 /// The IP's instance in the block design (and the overlay node's name: UIO reports it in
 /// `/sys/class/uio/uioN/name`).
 pub const CELL: &str = "snapgen_0";
+/// FCLK_CLK0 in the Zynq-7000 clock controller's numbering (the `clkc` binding: fclk0 is 15).
+pub const FCLK0_CLKC: u32 = 15;
 /// The overlay node's name, which the UIO driver reports as the device's name.
 pub const UIO_NAME: &str = "snapgen";
 /// The block design's name.
@@ -129,7 +131,7 @@ pub fn build_plan(
     );
     files.insert("build.tcl".into(), build_tcl(b, &top));
     files.insert(format!("{top}.xdc"), xdc(b, &ext, button));
-    files.insert(format!("{UIO_NAME}.dtso"), overlay(ps, &top));
+    files.insert(format!("{UIO_NAME}.dtso"), overlay(ps, timing, &top));
     files.insert(format!("{top}.bif"), bif(&top));
     files.insert("Makefile".into(), makefile(b, &top, &sources));
     files.insert("README.md".into(), readme(b, ps, timing, &top, &ext));
@@ -164,7 +166,7 @@ fn package_ip_tcl(b: &Board, sources: &[&str]) -> String {
             };
             let _ = writeln!(
                 regs,
-                "snapgen_register $block {reg} 0x{:02X} {access} 0x{:08X} {{{}}}",
+                "snapgen_register $block {reg} 0x{:02X} {access} {} {{{}}}",
                 snapgen_spec::axi::offset(k) + 4 * w,
                 r.reset,
                 r.doc.replace(['{', '}', '[', ']', '$', '\\', '"'], "")
@@ -192,15 +194,19 @@ set_property version {version} $core
 set_property display_name {{snapgen AXI4-Lite motion station}} $core
 set_property description {{snapgen's station (executor, motion core, controller, encoder, PWM, switches) behind an AXI4-Lite slave; register map docs/AXI.md}} $core
 
-# Bus interfaces: Vivado infers them from the port names; each is made sure of.
+# Bus interfaces, each inferred explicitly (what Vivado guessed from the port names is dropped,
+# so that the names below are the interfaces' names), then checked.
+ipx::remove_all_bus_interface $core
+foreach map [ipx::get_memory_maps -of_objects $core] {{
+    ipx::remove_memory_map [get_property name $map] $core
+}}
 proc snapgen_interface {{core name ports abstraction}} {{
-    if {{[llength [ipx::get_bus_interfaces $name -of_objects $core]] == 0}} {{
-        ipx::infer_bus_interface $ports $abstraction $core
+    ipx::infer_bus_interface $ports $abstraction $core
+    set busif [ipx::get_bus_interfaces $name -of_objects $core]
+    if {{[llength $busif] != 1}} {{
+        error \"snapgen: the IP has no bus interface $name after inferring it from $ports\"
     }}
-    if {{[llength [ipx::get_bus_interfaces $name -of_objects $core]] != 1}} {{
-        error \"snapgen: the IP has no bus interface $name\"
-    }}
-    return [ipx::get_bus_interfaces $name -of_objects $core]
+    return $busif
 }}
 proc snapgen_parameter {{busif name value}} {{
     set p [ipx::get_bus_parameters $name -of_objects $busif]
@@ -209,8 +215,8 @@ proc snapgen_parameter {{busif name value}} {{
     }}
     set_property value $value $p
 }}
-snapgen_interface $core {BUSIF} {{{axi_ports}}} xilinx.com:interface:aximm_rtl:1.0
-set clk [snapgen_interface $core {clock} {clock} xilinx.com:signal:clock_rtl:1.0]
+set axi [snapgen_interface $core {BUSIF} {{{axi_ports}}} xilinx.com:interface:aximm_rtl:1.0]
+snapgen_interface $core {clock} {clock} xilinx.com:signal:clock_rtl:1.0
 set rst [snapgen_interface $core reset reset xilinx.com:signal:reset_rtl:1.0]
 snapgen_parameter $rst POLARITY ACTIVE_HIGH
 set irq [snapgen_interface $core irq irq xilinx.com:signal:interrupt_rtl:1.0]
@@ -220,15 +226,9 @@ ipx::associate_bus_interfaces -clock {clock} -reset reset $core
 
 # The register map (snapgen_spec::axi, docs/AXI.md) in the IP's memory map: {span} bytes of a
 # {uio}-byte block.
-set map [ipx::get_memory_maps {BUSIF} -of_objects $core]
-if {{[llength $map] == 0}} {{
-    set map [ipx::add_memory_map {BUSIF} $core]
-    set_property slave_memory_map_ref {BUSIF} [ipx::get_bus_interfaces {BUSIF} -of_objects $core]
-}}
-set block [ipx::get_address_blocks -of_objects $map]
-if {{[llength $block] == 0}} {{
-    set block [ipx::add_address_block reg0 $map]
-}}
+set map [ipx::add_memory_map {BUSIF} $core]
+set_property slave_memory_map_ref {BUSIF} $axi
+set block [ipx::add_address_block reg0 $map]
 set_property range {uio} $block
 set_property width 32 $block
 proc snapgen_register {{block name offset access reset doc}} {{
@@ -237,8 +237,8 @@ proc snapgen_register {{block name offset access reset doc}} {{
     set_property size 32 $r
     set_property access $access $r
     set_property description $doc $r
-    ipx::add_register_parameter RESET_VALUE $r
-    set_property value $reset [ipx::get_register_parameters RESET_VALUE -of_objects $r]
+    set_property reset_value $reset $r
+    set_property reset_value_format long $r
 }}
 {regs}
 ipx::create_xgui_files $core
@@ -250,7 +250,11 @@ puts \"snapgen: packaged {vendor}:{library}:{name}:{version} in [file join $here
 ",
         desc = b.description,
         part = b.part,
-        files = sources.join(" "),
+        files = sources
+            .iter()
+            .map(|f| format!("[file join $here {f}]"))
+            .collect::<Vec<_>>()
+            .join(" "),
         axi_ports = AXI_TOP
             .section("axi")
             .filter(|p| p.name.starts_with(&format!("{BUSIF}_")))
@@ -307,7 +311,13 @@ fn block_design_tcl(
 set here [file dirname [file normalize [info script]]]
 set board_part {board_part}
 if {{[llength [get_board_parts -quiet $board_part]] == 0}} {{
-    error \"snapgen: Vivado does not know the board part $board_part: install the board vendor's board files (Digilent: github.com/Digilent/vivado-boards) and run again\"
+    # Another version of the same board's files (the preset is the board's, not the version's).
+    set other [lindex [get_board_parts -quiet -latest_file_version {board_family}:*] 0]
+    if {{$other eq \"\"}} {{
+        error \"snapgen: Vivado does not know the board part $board_part: install the board vendor's board files (Digilent: github.com/Digilent/vivado-boards) and run again\"
+    }}
+    puts \"snapgen: board part $board_part not installed; using $other\"
+    set board_part $other
 }}
 set_property board_part $board_part [current_project]
 set_property ip_repo_paths [list [file join $here ip]] [current_project]
@@ -330,7 +340,8 @@ create_bd_cell -type ip -vlnv {vendor}:{library}:{name}:{version} {CELL}
 # Reset: FCLK_RESET0_N, and the board's button (active high), synchronised to FCLK_CLK0.
 create_bd_cell -type ip -vlnv xilinx.com:ip:proc_sys_reset:5.0 rst_fclk0
 set_property -dict [list CONFIG.C_AUX_RESET_HIGH {{1}}] [get_bd_cells rst_fclk0]
-create_bd_port -dir I {btn}
+create_bd_port -dir I -type rst {btn}
+set_property CONFIG.POLARITY ACTIVE_HIGH [get_bd_ports {btn}]
 connect_bd_net [get_bd_ports {btn}] [get_bd_pins rst_fclk0/aux_reset_in]
 connect_bd_net [get_bd_pins ps7/FCLK_RESET0_N] [get_bd_pins rst_fclk0/ext_reset_in]
 # M_AXI_GP0 (AXI3) to the AXI4-Lite slave through an interconnect (protocol conversion).
@@ -359,6 +370,7 @@ update_compile_order -fileset sources_1
         desc = b.description,
         part = b.part,
         board_part = ps.board_part,
+        board_family = ps.board_part.rsplit_once(':').map_or(ps.board_part.as_str(), |(f, _)| f),
         base = ps.axi_base,
         uio = UIO_SPAN,
         irq_id = IRQ_F2P0_ID,
@@ -394,7 +406,7 @@ wait_on_run synth_1
 if {{[get_property PROGRESS [get_runs synth_1]] != \"100%\"}} {{
     error \"snapgen: synthesis failed (vivado/{top}.runs/synth_1/runme.log)\"
 }}
-launch_runs impl_1 -jobs 2
+launch_runs impl_1 -to_step write_bitstream -jobs 2
 wait_on_run impl_1
 if {{[get_property PROGRESS [get_runs impl_1]] != \"100%\"}} {{
     error \"snapgen: implementation failed (vivado/{top}.runs/impl_1/runme.log)\"
@@ -407,7 +419,8 @@ set whs [get_property SLACK [get_timing_paths -max_paths 1 -nworst 1 -hold]]
 if {{$wns < 0 || $whs < 0}} {{
     error \"snapgen: routed timing does not close (setup slack $wns ns, hold slack $whs ns; timing.rpt): lower the clock (the board file's \\[ps\\] fclk_hz, or --clock-hz)\"
 }}
-write_bitstream -force [file join $here {top}.bit]
+# The run's bitstream becomes {top}.bit only when timing closes.
+file copy -force [file join [get_property DIRECTORY [get_runs impl_1]] {BD_NAME}_wrapper.bit] [file join $here {top}.bit]
 write_hw_platform -fixed -include_bit -force -file [file join $here {top}.xsa]
 puts \"snapgen: wrote {top}.bit and {top}.xsa; routed timing closes (setup slack $wns ns, hold slack $whs ns)\"
 ",
@@ -454,14 +467,15 @@ fn xdc(b: &Board, ext: &[External], button: &Pin) -> String {
 
 /// The device-tree overlay: the bitstream for the FPGA manager, and the station as a
 /// `generic-uio` device with its page and its interrupt.
-fn overlay(ps: &ProcessingSystem, top: &str) -> String {
+fn overlay(ps: &ProcessingSystem, timing: &Timing, top: &str) -> String {
     format!(
         "\
 // snapgen device-tree overlay: loads {top}.bit.bin through the FPGA manager and declares the
 // station at 0x{base:08x} ({uio} bytes, interrupt IRQ_F2P[0] = ID {irq_id}) as a UIO device named
 // \"{UIO_NAME}\" (/sys/class/uio/uioN/name). Linux's uio_pdrv_genirq binds it when the kernel
 // runs with uio_pdrv_genirq.of_id=generic-uio. Build: dtc -@ -I dts -O dtb -o {UIO_NAME}.dtbo {UIO_NAME}.dtso
-// Targets the labels of the Zynq-7000 device tree (fpga_full, amba, intc).
+// Targets the labels of the Zynq-7000 device tree (fpga_full, amba, intc, clkc): the board's
+// base device tree must be compiled with symbols (dtc -@).
 // Generated by `snapgen build --host ps`; do not edit: regenerate it.
 /dts-v1/;
 /plugin/;
@@ -480,9 +494,23 @@ fn overlay(ps: &ProcessingSystem, top: &str) -> String {
 \t\t\t#address-cells = <1>;
 \t\t\t#size-cells = <1>;
 
+\t\t\t/* FCLK_CLK0, the station's clock: kept running and at its rate (Xilinx's fclk driver;
+\t\t\t * without it a kernel turns the unused clock off at the end of boot). */
+\t\t\t{UIO_NAME}_fclk0: {UIO_NAME}-fclk0 {{
+\t\t\t\tcompatible = \"xlnx,fclk\";
+\t\t\t\t#clock-cells = <0>;
+\t\t\t\tclocks = <&clkc {FCLK0_CLKC}>;
+\t\t\t\tclock-output-names = \"{UIO_NAME}_fclk0\";
+\t\t\t\tassigned-clocks = <&clkc {FCLK0_CLKC}>;
+\t\t\t\tassigned-clock-rates = <{hz}>;
+\t\t\t}};
+
 \t\t\t{UIO_NAME}@{base:x} {{
 \t\t\t\tcompatible = \"snapgen,axi-station\", \"generic-uio\";
 \t\t\t\treg = <0x{base:x} 0x{uio:x}>;
+\t\t\t\tclocks = <&clkc {FCLK0_CLKC}>;
+\t\t\t\tassigned-clocks = <&clkc {FCLK0_CLKC}>;
+\t\t\t\tassigned-clock-rates = <{hz}>;
 \t\t\t\tinterrupt-parent = <&intc>;
 \t\t\t\t/* SPI {spi} (ID {irq_id}), level, active high */
 \t\t\t\tinterrupts = <0 {spi} 4>;
@@ -495,6 +523,7 @@ fn overlay(ps: &ProcessingSystem, top: &str) -> String {
         uio = UIO_SPAN,
         irq_id = IRQ_F2P0_ID,
         spi = IRQ_F2P0_ID - 32,
+        hz = timing.clock_hz,
     )
 }
 
@@ -597,10 +626,15 @@ To use the IP in a project of your own: `vivado -mode batch -source package_ip.t
 
 ## 2. Linux on the board
 
-Any Zynq-7000 Linux with the FPGA manager, device-tree overlays (configfs) and
-`uio_pdrv_genirq` will do (PetaLinux from `{top}.xsa`, or a PYNQ image). Start the kernel with
+A Zynq-7000 Linux with the FPGA manager, device-tree overlays through configfs
+(`CONFIG_OF_CONFIGFS`: Xilinx's kernel, PetaLinux from `{top}.xsa`, or a PYNQ image; mainline
+Linux has no configfs overlays) and `uio_pdrv_genirq`; its base device tree compiled with
+symbols (`dtc -@`), which the overlay's labels need. Start the kernel with
 `uio_pdrv_genirq.of_id=generic-uio` on its command line, so that the UIO driver takes the
-station's node.
+station's node. The overlay keeps FCLK_CLK0 running at {mhz} MHz through Xilinx's `xlnx,fclk`
+driver; a kernel without it turns the clock off at the end of boot unless started with
+`clk_ignore_unused`, and then runs it at whatever rate the boot loader set: check
+`/sys/kernel/debug/clk/fclk0/clk_rate` before anything moves.
 
 ```sh
 cp {top}.bit.bin /lib/firmware/

@@ -9,6 +9,10 @@
 #   STANDIN_SLACK         get_property SLACK (default 0.250)
 #   STANDIN_PROGRESS      get_property PROGRESS (default 100%)
 #
+# and two that act as Vivado's runs would on the disk: `launch_runs impl_1 ... -to_step
+# write_bitstream` leaves TOP.bit (TOP: the last `set_property top`) in impl_1's directory,
+# ./standin_runs/impl_1, which `get_property DIRECTORY` of a run answers.
+#
 # Usage: tclsh vivado_standin.tcl SCRIPT
 # Runs SCRIPT as Vivado would source it; the exit status is 1, with the error on stderr, when
 # the script raises an error.
@@ -18,9 +22,22 @@ proc standin_env {name default} {
     return $default
 }
 
+set ::standin_top ""
+set ::standin_run [file join [pwd] standin_runs impl_1]
+
 proc unknown {cmd args} {
     puts [join [concat [list CALL $cmd] $args] "\x1f"]
     switch -- $cmd {
+        set_property {
+            if {[lindex $args 0] eq "top"} { set ::standin_top [lindex $args 1] }
+        }
+        launch_runs {
+            if {[lindex $args 0] eq "impl_1" && [lsearch $args -to_step] >= 0
+                && [lindex $args [expr {[lsearch $args -to_step] + 1}]] eq "write_bitstream"} {
+                file mkdir $::standin_run
+                close [open [file join $::standin_run $::standin_top.bit] w]
+            }
+        }
         get_board_parts {
             set asked [lindex $args end]
             return [standin_env STANDIN_BOARD_PARTS $asked]
@@ -30,6 +47,7 @@ proc unknown {cmd args} {
                 CONFIG.PCW_ACT_FPGA0_PERIPHERAL_FREQMHZ { return [standin_env STANDIN_FCLK_MHZ 100.000000] }
                 SLACK { return [standin_env STANDIN_SLACK 0.250] }
                 PROGRESS { return [standin_env STANDIN_PROGRESS 100%] }
+                DIRECTORY { return $::standin_run }
             }
             return "<property [lindex $args 0]>"
         }
