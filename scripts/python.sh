@@ -2,7 +2,7 @@
 # The Python package (python/, PyO3 + maturin, abi3): builds its wheel, installs it into a
 # venv in the snapgen cache (with NumPy and pytest from PyPI, pinned) and runs its tests
 # (python/tests). Part of the test command. With --aarch64 it also cross-builds the aarch64
-# wheel with the cross toolchain scripts/arm64.sh installs (built, not run: there is no aarch64
+# wheel with the cross toolchain scripts/arm.sh installs (built, not run: there is no aarch64
 # Python here; left out of the test command for its time).
 #
 #   ./scripts/python.sh             # build, install, test
@@ -50,6 +50,6 @@ if command -v aarch64-linux-gnu-gcc >/dev/null && rustup target list --installed
   [ "$machine" = "b700" ] || { echo "$arm: the extension is not an aarch64 binary ($machine)" >&2; exit 1; }
   echo "built $arm (aarch64, not run here)"
 else
-  echo "no aarch64 cross toolchain: run scripts/arm64.sh first (it installs it)" >&2
+  echo "no aarch64 cross toolchain: run scripts/arm.sh first (it installs it)" >&2
   exit 1
 fi

@@ -2,7 +2,8 @@
 # The project's test command (README, CI): installs what the tests need when it is missing
 # (scripts/setup.sh), then checks formatting and lints, runs every test, checks routed timing
 # of the blocks that must close it on their own (scripts/route.sh), checks that the ARM64
-# host build plans bit-identically under emulation (scripts/arm64.sh), builds and tests the
+# and armv7 host builds plan and run the host axis bit-identically under emulation
+# (scripts/arm.sh), builds and tests the
 # Python package (scripts/python.sh) and checks that the crates build with their rust-version
 # (scripts/msrv.sh).
 #
@@ -27,8 +28,8 @@ awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i+1) ~ /^passed/) p += 
      END { printf "%d passed, %d failed\n", p, f }' "$log"
 echo "== routed timing"
 ./scripts/route.sh
-echo "== arm64 host"
-./scripts/arm64.sh
+echo "== ARM hosts"
+./scripts/arm.sh
 echo "== Python package"
 ./scripts/python.sh
 echo "== minimum Rust version"

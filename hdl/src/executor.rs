@@ -358,7 +358,7 @@ pub fn executor_verilog(d: &Dividers, input_polarity: u8) -> String {
         over.push_str(&format!("{pn}: cfg_over = {};\n", above_max(p.param)));
         select.push_str(&format!("pre_cfg_sel[{k}] <= cfg_param == {pn};\n"));
         set.push_str(&format!(
-            "if (pre_cfg_sel[{k}]) n_{name} = cfg_value[{bits}-1:0];\n"
+            "if (cfg_sel_q[{k}]) n_{name} = cfg_value_q[{bits}-1:0];\n"
         ));
         regs.push_str(&format!(
             "reg [{bits}-1:0] {name}_q = {bits}'d0, n_{name};   // {}\n",

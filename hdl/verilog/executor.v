@@ -196,8 +196,9 @@ wire accel_pair_valid = accel_nonzero && (accel_hi_lt || (accel_hi_eq && accel_l
 
 // ---- The frame's decode, a clock ahead -------------------------------------------------------
 // The command, its length and its payload are complete two bytes before the frame is checked,
-// and the registers they are checked against (the parameters) change only when a frame is
-// executed (a frame's bytes, at least 40 bit times, before the next one is) or by a reset
+// and the registers they are checked against (the parameters) change only on the clock after a
+// frame is executed (a frame's bytes, at least 40 bit times or ten clocks, before the next one
+// is) or by a reset
 // (which the frame receiver shares): what depends on them alone is registered on every clock
 // (the stop limits' compares in two stages, above) and is exact on the frame's clock (the state is read on that clock itself; the core's outputs a clock earlier,
 // through in_*, and the received CRC on the frame receiver's own clock, through pre_retry).
@@ -366,6 +367,21 @@ always @(posedge clock)
 // core's at_rest is a register: it tells where the last tick left the chain a clock later).
 wire settling = start_q || stop_q || swap_q || start_q2 || stop_q2 || swap_q2 || was_driven_q;
 wire driven = in_busy || in_stopping;
+
+// CONFIGURE takes effect on the clock after the frame is executed: its decision is registered
+// with the parameter (one-hot) and the value, and the parameter's register is written from
+// these on the next clock. The decision's path then ends at one flip-flop, not at the enables
+// of every parameter register's bits (some 700 of them, spread over the device).
+reg cfg_write_q = 1'b0;
+reg [PARAM_COUNT-1:0] cfg_sel_q = {PARAM_COUNT{1'b0}};
+reg cfg_telemetry_q = 1'b0;
+reg [D_BITS-1:0] cfg_value_q = {D_BITS{1'b0}};
+always @(posedge clock) begin
+   cfg_write_q <= !reset && taken(CMD_CONFIGURE, state_q);
+   cfg_sel_q <= pre_cfg_sel;
+   cfg_telemetry_q <= cfg_param == P_TELEMETRY_PERIOD;
+   cfg_value_q <= cfg_value;
+end
 
 // ---- Next state, in the model's order ------------------------------------------------------
 always @(*) begin
@@ -545,10 +561,11 @@ always @(*) begin
    end
    if (taken(CMD_HALT, state_q) && ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION)))
       n_stop = 1'b1;
-   if (taken(CMD_CONFIGURE, state_q)) begin
+   // CONFIGURE taken on the last clock (cfg_write_q, below) writes its parameter now.
+   if (cfg_write_q) begin
       //@ param_set
-      if (cfg_param == P_TELEMETRY_PERIOD)
-         n_telemetry_left = cfg_value[TELEMETRY_PERIOD_BITS-1:0];
+      if (cfg_telemetry_q)
+         n_telemetry_left = cfg_value_q[TELEMETRY_PERIOD_BITS-1:0];
    end
    if (taken(CMD_POWER, state_q)) begin
       if (pre_power_on) begin

@@ -94,7 +94,7 @@ macro_rules! with_params {
             // Read by the motion core.
             core {
                 TickDivider = 1, "TICK_DIVIDER", tick_divider: u32, 32, unsigned, Design, AtRest,
-                    "clocks per tick − 1: Ts = (value + 1) / clock (PING reports the clock); from the clock after next (the tick is a register), so the tick being counted ends when the clocks counted since the last tick reach the new value (at once if they are past it)";
+                    "clocks per tick − 1: Ts = (value + 1) / clock (PING reports the clock); from the third clock after the one that executes CONFIGURE (the write and the tick are registers), so the tick being counted ends when the clocks counted since the last tick reach the new value (at once if they are past it)";
                 StopJerk = 5, "STOP_JERK", stop_jerk: i128, $crate::widths::D_BITS, signed, Value(0), AtRest,
                     "the stop's jerk limit, raw (jerk LSBs per tick); 0 = unset: POWER 1 is refused";
                 StopAccel = 6, "STOP_ACCEL", stop_accel: i128, $crate::widths::D_BITS, signed, Value(0), AtRest,

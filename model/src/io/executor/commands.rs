@@ -215,11 +215,9 @@ impl Executor {
                 o.command.stop = true;
             }
             code::CONFIGURE => {
+                // Written on the next clock (`Executor::clock`).
                 let p = Param::from_byte(rx.get(&CFG_PARAM) as u8).expect("checked");
-                o.config.set(p, rx.get(&CFG_VALUE));
-                if p == Param::TelemetryPeriod {
-                    self.telemetry_left = o.config.telemetry_period;
-                }
+                self.configure = Some((p, rx.get(&CFG_VALUE)));
             }
             code::POWER => match (rx.get(&POWER_ON) == 1, s) {
                 (true, AxisState::Disabled) => {

@@ -192,6 +192,10 @@ pub struct Executor {
     /// emptied on this one (a clock later, so that the stop's decision does not reach the
     /// count's register in the same clock).
     empty_standby: bool,
+    /// A CONFIGURE taken on the last clock: its parameter and value, written on this one (a
+    /// clock later, so that the command's decision does not reach the enables of every
+    /// parameter register in the same clock).
+    configure: Option<(Param, i128)>,
 }
 
 impl Executor {
@@ -276,6 +280,7 @@ impl Executor {
             self.first_direction = 0;
             self.swap_lead = 0;
             self.expired = false;
+            self.configure = None;
             return self.out;
         }
         let s = before.state;
@@ -332,6 +337,14 @@ impl Executor {
         } else if i.rx.dropped {
             o.bad_frames = o.bad_frames.wrapping_add(1);
             self.queue(i, nak(0, 0, Reason::Framing));
+        }
+        // The CONFIGURE taken on the last clock writes its parameter (and restarts the telemetry
+        // countdown when it sets the period).
+        if let Some((p, v)) = self.configure.take() {
+            self.out.config.set(p, v);
+            if p == Param::TelemetryPeriod {
+                self.telemetry_left = self.out.config.telemetry_period;
+            }
         }
         let executed = !i.rx.bad_crc && !i.rx.dropped && i.rx.frame && self.command(i, s, cfg);
         let o = &mut self.out;
