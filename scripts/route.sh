@@ -61,12 +61,24 @@ if [ "${ROUTE_ALL:-0}" = 1 ]; then
   route snapgen_path_sequencer "4 axes"
   route snapgen_step_dir "one axis"
 fi
-route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generators"
-route snapgen_core "the motion core: sequencer, chain, stop unit"
+# The blocks on their own in the background, the board design beside them (nextpnr runs on
+# one core: the two take the machine's two), then their reports in order.
+(
+  route snapgen_path_steppers "4 axes: sequencer, interpolator, 4 step/dir generators"
+  route snapgen_core "the motion core: sequencer, chain, stop unit"
+) >"$work/blocks.out" 2>&1 &
+blocks=$!
 # The board design (I/O top, motion core, the PLL, the pins) to a bitstream, at the ULX3S's
 # clock.
-if ! ./target/release/snapgen build --board ulx3s --out "$work/ulx3s" >"$work/ulx3s.out"; then
+board=0
+./target/release/snapgen build --board ulx3s --out "$work/ulx3s" >"$work/ulx3s.out" 2>&1 || board=$?
+status=0
+wait "$blocks" || status=$?
+cat "$work/blocks.out"
+[ "$status" -eq 0 ] || exit 1
+if [ "$board" -ne 0 ]; then
   # (The build directory goes with $work: its logs' ends here.)
+  tail -3 "$work/ulx3s.out" >&2
   tail -5 "$work/ulx3s/nextpnr.log" "$work/ulx3s/yosys.log" >&2 2>/dev/null || true
   exit 1
 fi

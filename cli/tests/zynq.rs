@@ -438,38 +438,26 @@ fn check(dir: &Path) {
     }
 }
 
+/// `snapgen build --host ps` with `args`, refused with a message containing `says`.
+fn refused(args: &[&str], says: &str) {
+    let out_dir = tmp("refused");
+    let mut all = vec!["build", "--host", "ps", "--out", out_dir.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let out = snapgen(&all);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains(says),
+        "{args:?}: {err}"
+    );
+}
+
 #[test]
 fn the_ps_build_needs_a_zynq_and_a_clock_it_can_make() {
-    let out = snapgen(&[
-        "build",
-        "--board",
-        "ulx3s",
-        "--host",
-        "ps",
-        "--out",
-        tmp("ulx3s").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && err.contains("no processing system"),
-        "{err}"
-    );
+    refused(&["--board", "ulx3s"], "no processing system");
     // 1000 MHz / 123 MHz is no product of two dividers.
-    let out = snapgen(&[
-        "build",
-        "--board",
-        "zybo-z7-10",
-        "--host",
-        "ps",
-        "--clock-hz",
-        "123e6",
-        "--out",
-        tmp("odd").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && err.contains("two dividers of 1 to 63"),
-        "{err}"
+    refused(
+        &["--board", "zybo-z7-10", "--clock-hz", "123e6"],
+        "two dividers of 1 to 63",
     );
     // 1000 MHz / 125 MHz = 8: the script asks the PS for 125 MHz.
     let dir = tmp("125");

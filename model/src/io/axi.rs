@@ -23,7 +23,7 @@
 //! Every register's value is a function of the registers before the edge, as in the fabric.
 
 use snapgen_spec::axi::{
-    at, Access, Register, ADDR_BITS, IRQ_ALL, IRQ_DONE, IRQ_FAULT, IRQ_LATCHED, IRQ_REPLY,
+    at, Access, Register, Snap, ADDR_BITS, IRQ_ALL, IRQ_DONE, IRQ_FAULT, IRQ_LATCHED, IRQ_REPLY,
     IRQ_SWAP, REPLY_VALID, RESP_OKAY, RESP_SLVERR, STATUS_DONE_BIT, STATUS_STATE_LSB,
     STATUS_SWAP_PENDING_BIT,
 };
@@ -51,23 +51,34 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
-    /// Word `word` of the register `name` (one of STATUS, TICKS, X, V, A, J).
-    fn word(&self, name: &str, word: u32) -> u32 {
-        let wide = |v: i128| (v >> (32 * word)) as u32;
-        match name {
-            "STATUS" => {
-                let mut bytes = [0u8; Status::BYTES];
-                self.status.write_payload(&mut bytes);
+    /// Word `word` of the register that latches the station's port `snap.port`
+    /// (`Register::snap`: status, ticks, x, v, a, j), widened as `snap.signed` says.
+    fn word(&self, snap: &Snap, word: u32) -> u32 {
+        let wide = |v: i128| {
+            if 32 * word >= 128 {
+                // Past the value's 128 bits: its sign, or zeros.
+                if snap.signed && v < 0 {
+                    u32::MAX
+                } else {
+                    0
+                }
+            } else {
+                (v >> (32 * word)) as u32
+            }
+        };
+        match snap.port {
+            "status" => {
+                let bytes = status_bytes(&self.status);
                 (0..4).fold(0, |w, k| {
                     let b = bytes.get(4 * word as usize + k).copied().unwrap_or(0);
                     w | u32::from(b) << (8 * k)
                 })
             }
-            "TICKS" => (self.ticks >> (32 * word)) as u32,
-            "X" => wide(self.x),
-            "V" => wide(self.v),
-            "A" => wide(self.a),
-            "J" => wide(self.j),
+            "ticks" => wide(i128::from(self.ticks)),
+            "x" => wide(self.x),
+            "v" => wide(self.v),
+            "a" => wide(self.a),
+            "j" => wide(self.j),
             _ => 0,
         }
     }
@@ -97,18 +108,16 @@ pub struct AxiSlave {
     snapshot: Snapshot,
 }
 
-/// The status bit `bit` of the station's `status` port.
-fn status_bit(s: &Status, bit: u32) -> bool {
+/// The station's `status` port as bytes (byte 0 in bits 7:0).
+fn status_bytes(s: &Status) -> [u8; Status::BYTES] {
     let mut bytes = [0u8; Status::BYTES];
     s.write_payload(&mut bytes);
-    bytes[bit as usize / 8] >> (bit % 8) & 1 == 1
+    bytes
 }
 
-/// The station's state byte is ErrorStop.
-fn faulted(s: &Status) -> bool {
-    let mut bytes = [0u8; Status::BYTES];
-    s.write_payload(&mut bytes);
-    bytes[STATUS_STATE_LSB as usize / 8] == AxisState::ErrorStop as u8
+/// Bit `bit` of the status block's bytes.
+fn status_bit(bytes: &[u8; Status::BYTES], bit: u32) -> bool {
+    bytes[bit as usize / 8] >> (bit % 8) & 1 == 1
 }
 
 impl AxiSlave {
@@ -146,8 +155,10 @@ impl AxiSlave {
             "REPLY" => 0,
             "IRQ_STATUS" => self.irq_status(st),
             "IRQ_ENABLE" => self.irq_enable,
-            "STATUS" | "TICKS" | "X" | "V" | "A" | "J" => self.snapshot.word(r.name, word),
-            _ => r.reset,
+            _ => match &r.snap {
+                Some(snap) => self.snapshot.word(snap, word),
+                None => r.reset,
+            },
         }
     }
 
@@ -212,9 +223,11 @@ impl AxiSlave {
         }
         self.r_valid = ar_fire || (before.r_valid && !i.s_axi_rready);
         // Interrupt causes, from the status before the edge.
-        let done = status_bit(&st.status, STATUS_DONE_BIT);
-        let fault = faulted(&st.status);
-        let swap = status_bit(&st.status, STATUS_SWAP_PENDING_BIT);
+        let bytes = status_bytes(&st.status);
+        let done = status_bit(&bytes, STATUS_DONE_BIT);
+        // The state byte is ErrorStop.
+        let fault = bytes[STATUS_STATE_LSB as usize / 8] == AxisState::ErrorStop as u8;
+        let swap = status_bit(&bytes, STATUS_SWAP_PENDING_BIT);
         let mut events = 0;
         if done && !before.was_done {
             events |= IRQ_DONE;
