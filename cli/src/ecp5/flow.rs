@@ -116,37 +116,54 @@ pub fn parse_nextpnr_log(text: &str) -> Option<Routed> {
     })
 }
 
+/// Runs step `s` in `dir`, its log kept (an earlier build's log and result removed first).
+fn run_step(s: &Step, dir: &Path) -> anyhow::Result<(PathBuf, std::process::Output)> {
+    let exe = s.tool.find()?;
+    // A log or a result of an earlier build in the same directory must not be read as
+    // this one's.
+    for old in [&s.log, &s.target] {
+        let p = dir.join(old);
+        if p.exists() {
+            std::fs::remove_file(&p).with_context(|| format!("cannot remove {}", p.display()))?;
+        }
+    }
+    let out = Command::new(&exe)
+        .args(&s.args)
+        .current_dir(dir)
+        .output()
+        .with_context(|| format!("cannot run {}", exe.display()))?;
+    let log = dir.join(&s.log);
+    if s.tool == Tool::Ecppack {
+        let mut text = out.stdout.clone();
+        text.extend_from_slice(&out.stderr);
+        std::fs::write(&log, text).with_context(|| format!("cannot write {}", log.display()))?;
+    }
+    Ok((exe, out))
+}
+
+/// The error of a step that failed: the tool, its status, its log and the end of its stderr.
+fn step_failed(exe: &Path, out: &std::process::Output, log: &Path) -> anyhow::Error {
+    let text = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = text.lines().collect();
+    anyhow::anyhow!(
+        "{} failed ({}); its log: {}\n{}",
+        exe.display(),
+        out.status,
+        log.display(),
+        lines[lines.len().saturating_sub(5)..].join("\n")
+    )
+}
+
 /// Runs the build in `dir` (its files written): every step, its log kept; fails when a tool
 /// fails or routed timing does not close at the board's clock. Returns the routed report.
 pub fn run(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> {
     for s in steps {
-        let exe = s.tool.find()?;
-        // A log or a result of an earlier build in the same directory must not be read as
-        // this one's.
-        for old in [&s.log, &s.target] {
-            let p = dir.join(old);
-            if p.exists() {
-                std::fs::remove_file(&p)
-                    .with_context(|| format!("cannot remove {}", p.display()))?;
-            }
-        }
-        let out = Command::new(&exe)
-            .args(&s.args)
-            .current_dir(dir)
-            .output()
-            .with_context(|| format!("cannot run {}", exe.display()))?;
+        let (exe, out) = run_step(s, dir)?;
         let log = dir.join(&s.log);
-        if s.tool == Tool::Ecppack {
-            let mut text = out.stdout.clone();
-            text.extend_from_slice(&out.stderr);
-            std::fs::write(&log, text)
-                .with_context(|| format!("cannot write {}", log.display()))?;
-        }
         if s.tool == Tool::Nextpnr {
             let text = std::fs::read_to_string(&log).unwrap_or_default();
-            let routed = parse_nextpnr_log(&text);
-            if let Some(r) = &routed {
-                check_target(r, clock_hz)?;
+            if let Some(r) = parse_nextpnr_log(&text) {
+                check_target(&r, clock_hz)?;
                 if !r.pass {
                     bail!(
                         "routed timing does not close: {:.2} MHz routed for the {:.2} MHz fabric clock (nextpnr's log: {})",
@@ -158,22 +175,7 @@ pub fn run(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> 
             }
         }
         if !out.status.success() {
-            let tail: Vec<String> = String::from_utf8_lossy(&out.stderr)
-                .lines()
-                .rev()
-                .take(5)
-                .map(str::to_string)
-                .collect::<Vec<_>>()
-                .into_iter()
-                .rev()
-                .collect();
-            bail!(
-                "{} failed ({}); its log: {}\n{}",
-                exe.display(),
-                out.status,
-                log.display(),
-                tail.join("\n")
-            );
+            return Err(step_failed(&exe, &out, &log));
         }
     }
     let text = std::fs::read_to_string(dir.join("nextpnr.log")).context("nextpnr.log")?;
@@ -181,6 +183,26 @@ pub fn run(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> 
         .context("nextpnr's log has no routed timing report (Max frequency for clock …)")?;
     check_target(&r, clock_hz)?;
     Ok(r)
+}
+
+/// Synthesises, places and routes (the steps up to nextpnr's; no bitstream) and returns the
+/// routed report whether or not timing closes (`snapgen synth --routed`).
+pub fn route_report(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> {
+    for s in steps.iter().filter(|s| s.tool != Tool::Ecppack) {
+        let (exe, out) = run_step(s, dir)?;
+        let log = dir.join(&s.log);
+        if s.tool == Tool::Nextpnr {
+            let text = std::fs::read_to_string(&log).unwrap_or_default();
+            if let Some(r) = parse_nextpnr_log(&text) {
+                check_target(&r, clock_hz)?;
+                return Ok(r);
+            }
+        }
+        if !out.status.success() {
+            return Err(step_failed(&exe, &out, &log));
+        }
+    }
+    bail!("the flow has no nextpnr step, or nextpnr's log has no routed timing report")
 }
 
 /// nextpnr routed for the clock the design was generated for (its UART divisor and Ts count
@@ -226,5 +248,51 @@ mod tests {
         assert_eq!((r.fmax_mhz, r.target_mhz, r.pass), (91.47, 100.0, false));
         assert_eq!((r.luts, r.ffs), (None, None));
         assert!(parse_nextpnr_log("Info: nothing routed\n").is_none());
+    }
+
+    /// `route_report` returns a route that does not close (and makes no bitstream), where
+    /// `run` refuses it; both refuse a report for another clock. The tools are stand-ins
+    /// (shell scripts named by the environment variables `Tool::find` reads).
+    #[test]
+    fn a_route_that_does_not_close_is_reported_not_refused() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = std::env::temp_dir().join(format!("snapgen-flow-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = |name: &str, body: &str| {
+            let p = dir.join(name);
+            std::fs::write(&p, format!("#!/bin/sh\n{body}\n")).unwrap();
+            std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+            p
+        };
+        let yosys = script("fake-yosys", "exit 0");
+        let nextpnr = script(
+            "fake-nextpnr",
+            "echo \"Info: Max frequency for clock 'clk': 90.12 MHz (FAIL at 125.00 MHz)\" > nextpnr.log\nexit 1",
+        );
+        let ecppack = script("fake-ecppack", "touch ecppack-ran\nexit 0");
+        std::env::set_var("SNAPGEN_YOSYS", &yosys);
+        std::env::set_var("SNAPGEN_NEXTPNR_ECP5", &nextpnr);
+        std::env::set_var("SNAPGEN_ECPPACK", &ecppack);
+        let step = |tool, target: &str, log: &str| Step {
+            tool,
+            args: Vec::new(),
+            target: target.into(),
+            deps: Vec::new(),
+            log: log.into(),
+        };
+        let steps = [
+            step(Tool::Yosys, "top.json", "yosys.log"),
+            step(Tool::Nextpnr, "top.config", "nextpnr.log"),
+            step(Tool::Ecppack, "top.bit", "ecppack.log"),
+        ];
+        let r = route_report(&steps, &dir, 125_000_000).unwrap();
+        assert_eq!((r.fmax_mhz, r.target_mhz, r.pass), (90.12, 125.0, false));
+        assert!(!dir.join("ecppack-ran").exists(), "a bitstream step ran");
+        let e = run(&steps, &dir, 125_000_000).unwrap_err().to_string();
+        assert!(e.contains("routed timing does not close: 90.12 MHz"), "{e}");
+        let e = route_report(&steps, &dir, 100_000_000)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("nextpnr routed for 125.00 MHz"), "{e}");
     }
 }

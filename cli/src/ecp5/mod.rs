@@ -8,7 +8,7 @@
 pub mod flow;
 pub mod pll;
 
-pub use flow::{run, Routed};
+pub use flow::{route_report, run, Routed};
 pub use pll::{solve_pll, PllSetting};
 
 use crate::board_spec::{Board, Pull};
