@@ -109,7 +109,7 @@ for t in "${targets[@]}"; do
   echo "== the host axis over the UIO link's registers on the simulated AXI board, on $target under qemu-user"
   online=(online --script examples/online_short.toml --board axi-model --json)
   a=$("${qemu[@]}" "$arm" "${online[@]}" 2>&1) || { echo "$a" >&2; exit 1; }
-  b=$("$x86" "${online[@]}" 2>&1)
+  b=$("$x86" "${online[@]}" 2>&1) || { echo "$b" >&2; exit 1; }
   if [ "$a" != "$b" ]; then
     echo "DIFFERENT online reports on $target and $(uname -m)" >&2
     diff <(echo "$b") <(echo "$a") | head -20 >&2

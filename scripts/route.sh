@@ -74,12 +74,12 @@ board=0
 ./target/release/snapgen build --board ulx3s --out "$work/ulx3s" >"$work/ulx3s.out" 2>&1 || board=$?
 status=0
 wait "$blocks" || status=$?
-cat "$work/blocks.out"
-[ "$status" -eq 0 ] || exit 1
+if [ "$status" -eq 0 ]; then cat "$work/blocks.out"; else cat "$work/blocks.out" >&2; fi
 if [ "$board" -ne 0 ]; then
   # (The build directory goes with $work: its logs' ends here.)
   tail -3 "$work/ulx3s.out" >&2
   tail -5 "$work/ulx3s/nextpnr.log" "$work/ulx3s/yosys.log" >&2 2>/dev/null || true
-  exit 1
+else
+  tail -1 "$work/ulx3s.out"
 fi
-tail -1 "$work/ulx3s.out"
+[ "$status" -eq 0 ] && [ "$board" -eq 0 ]

@@ -4,9 +4,11 @@
 # the unit separator \x1f) and answers with a placeholder object, except the few queries whose
 # answers steer the scripts, which answer what the environment says:
 #
-#   STANDIN_BOARD_PARTS   get_board_parts (default: the part asked for)
+#   STANDIN_BOARD_PARTS   get_board_parts of one part (default: the part asked for)
+#   STANDIN_LATEST_PARTS  get_board_parts -latest_file_version (default: the pattern asked for)
 #   STANDIN_FCLK_MHZ      get_property CONFIG.PCW_ACT_FPGA0_PERIPHERAL_FREQMHZ (default 100.000000)
-#   STANDIN_SLACK         get_property SLACK (default 0.250)
+#   STANDIN_SETUP_SLACK   get_property SLACK of a path get_timing_paths -setup gave (default 0.250)
+#   STANDIN_HOLD_SLACK    ... of one get_timing_paths -hold gave (default 0.050)
 #   STANDIN_PROGRESS      get_property PROGRESS (default 100%)
 #
 # and two that act as Vivado's runs would on the disk: `launch_runs impl_1 ... -to_step
@@ -40,12 +42,25 @@ proc unknown {cmd args} {
         }
         get_board_parts {
             set asked [lindex $args end]
+            if {[lsearch $args -latest_file_version] >= 0} {
+                return [standin_env STANDIN_LATEST_PARTS $asked]
+            }
             return [standin_env STANDIN_BOARD_PARTS $asked]
+        }
+        get_timing_paths {
+            # A path object that says which check it is.
+            if {[lsearch $args -hold] >= 0} { return "<path:hold>" }
+            return "<path:setup>"
         }
         get_property {
             switch -- [lindex $args 0] {
                 CONFIG.PCW_ACT_FPGA0_PERIPHERAL_FREQMHZ { return [standin_env STANDIN_FCLK_MHZ 100.000000] }
-                SLACK { return [standin_env STANDIN_SLACK 0.250] }
+                SLACK {
+                    if {[lindex $args 1] eq "<path:hold>"} {
+                        return [standin_env STANDIN_HOLD_SLACK 0.050]
+                    }
+                    return [standin_env STANDIN_SETUP_SLACK 0.250]
+                }
                 PROGRESS { return [standin_env STANDIN_PROGRESS 100%] }
                 DIRECTORY { return $::standin_run }
             }

@@ -94,7 +94,9 @@ fn standin(dir: &Path, script: &str, env: &[(&str, &str)]) -> (bool, Vec<Vec<Str
         .arg(script)
         .env_remove("STANDIN_BOARD_PARTS")
         .env_remove("STANDIN_FCLK_MHZ")
-        .env_remove("STANDIN_SLACK")
+        .env_remove("STANDIN_SETUP_SLACK")
+        .env_remove("STANDIN_HOLD_SLACK")
+        .env_remove("STANDIN_LATEST_PARTS")
         .env_remove("STANDIN_PROGRESS")
         .envs(env.iter().copied())
         .output()
@@ -356,17 +358,25 @@ fn check(dir: &Path) {
     assert!(dir.join(format!("{TOP}.bit")).exists());
 
     // Each of the scripts' guards fires on what it guards against, and stops the build.
-    for (env, says) in [
-        (("STANDIN_SLACK", "-0.012"), "routed timing does not close"),
+    let cases: [(&[(&str, &str)], &str); 5] = [
         (
-            ("STANDIN_FCLK_MHZ", "111.111115"),
+            &[("STANDIN_SETUP_SLACK", "-0.012")],
+            "routed timing does not close",
+        ),
+        (&[("STANDIN_HOLD_SLACK", "-0.004")], "hold slack -0.004"),
+        (
+            &[("STANDIN_FCLK_MHZ", "111.111115")],
             "FCLK_CLK0 at 111.111115 MHz",
         ),
-        (("STANDIN_BOARD_PARTS", ""), "does not know the board part"),
-        (("STANDIN_PROGRESS", "0%"), "synthesis failed"),
-    ] {
+        (
+            &[("STANDIN_BOARD_PARTS", ""), ("STANDIN_LATEST_PARTS", "")],
+            "does not know the board part",
+        ),
+        (&[("STANDIN_PROGRESS", "0%")], "synthesis failed"),
+    ];
+    for (env, says) in cases {
         let _ = std::fs::remove_file(dir.join(format!("{TOP}.bit")));
-        let (ok, calls, err) = standin(dir, "build.tcl", &[env]);
+        let (ok, calls, err) = standin(dir, "build.tcl", env);
         assert!(!ok && err.contains(says), "{env:?}: {err}");
         assert!(
             !dir.join(format!("{TOP}.bit")).exists()
@@ -374,6 +384,17 @@ fn check(dir: &Path) {
             "{env:?}: a bitstream or platform was written"
         );
     }
+    // Another version of the board's files than the board file names is taken.
+    let other = "digilentinc.com:zybo-z7-10:part0:1.0";
+    let (ok, calls, err) = standin(
+        dir,
+        "build.tcl",
+        &[("STANDIN_BOARD_PARTS", ""), ("STANDIN_LATEST_PARTS", other)],
+    );
+    assert!(ok, "{err}");
+    assert!(calls
+        .iter()
+        .any(|c| c[0] == "set_property" && c[1] == "board_part" && c[2] == other));
 
     // The overlay compiles without a warning and says what the Zynq-7000 needs: the page at
     // the base, IRQ_F2P[0] = interrupt ID 61 (UG585 Table 7-4) = SPI 29, level high.

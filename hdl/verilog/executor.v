@@ -561,7 +561,7 @@ always @(*) begin
    end
    if (taken(CMD_HALT, state_q) && ((state_q == S_DISCRETE_MOTION) || (state_q == S_CONTINUOUS_MOTION)))
       n_stop = 1'b1;
-   // CONFIGURE taken on the last clock (cfg_write_q, below) writes its parameter now.
+   // CONFIGURE taken on the last clock (cfg_write_q, above) writes its parameter now.
    if (cfg_write_q) begin
       //@ param_set
       if (cfg_telemetry_q)

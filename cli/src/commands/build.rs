@@ -90,9 +90,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         println!("wrote {}", f.display());
     }
     if !run {
-        let needs = match b.toolchain() {
-            Toolchain::Vivado => "Vivado",
-            Toolchain::OpenEcp5 => "Yosys, nextpnr-ecp5 and ecppack",
+        let needs = match (b.toolchain(), ps) {
+            (Toolchain::Vivado, Some(_)) => "Vivado with its bootgen, and dtc",
+            (Toolchain::Vivado, None) => "Vivado",
+            (Toolchain::OpenEcp5, _) => "Yosys, nextpnr-ecp5 and ecppack",
         };
         println!("run it with: make -C {} (needs {needs})", out.display());
         return Ok(());

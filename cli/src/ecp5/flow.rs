@@ -294,5 +294,8 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("nextpnr routed for 125.00 MHz"), "{e}");
+        for var in ["SNAPGEN_YOSYS", "SNAPGEN_NEXTPNR_ECP5", "SNAPGEN_ECPPACK"] {
+            std::env::remove_var(var);
+        }
     }
 }
