@@ -135,7 +135,10 @@ pub fn build_plan(
     files.insert(format!("{UIO_NAME}.dtso"), overlay(ps, timing, &top));
     files.insert(format!("{top}.bif"), bif(&top));
     files.insert("Makefile".into(), makefile(b, &top, &sources));
-    files.insert("README.md".into(), readme(b, ps, timing, &top, &ext));
+    files.insert(
+        "README.md".into(),
+        readme(b, ps, timing, &top, &ext, button),
+    );
     Ok(BuildPlan {
         files,
         runner: Runner::Vivado,
@@ -577,6 +580,7 @@ fn readme(
     timing: &Timing,
     top: &str,
     ext: &[External],
+    button: &Pin,
 ) -> String {
     let pins: String = ext
         .iter()
@@ -701,8 +705,8 @@ format before anything moves (as over a serial port).
         board_part = ps.board_part,
         pll = ps.io_pll_hz as f64 / 1e6,
         vlnv = IP_VLNV.join(":"),
-        btn = reset_button(b).map_or("", |p| p.port.as_str()),
-        btn_pin = reset_button(b).map_or("", |p| p.pin.as_str()),
-        btn_use = reset_button(b).map_or("", |p| p.comment.as_str()),
+        btn = button.port,
+        btn_pin = button.pin,
+        btn_use = button.comment,
     )
 }

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::{lint_clean, snapgen, snapgen_ok};
+use common::{assert_ok, lint_clean, snapgen};
 
 const TOP: &str = "snapgen_zybo_z7_10_ps";
 
@@ -132,15 +132,7 @@ fn module_ports(verilog: &str, name: &str) -> BTreeMap<String, String> {
 #[test]
 fn the_ps_build_is_whole_and_its_names_agree() {
     let dir = tmp("zybo");
-    snapgen_ok(&[
-        "build",
-        "--board",
-        "zybo-z7-10",
-        "--host",
-        "ps",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    assert_ok(&ps_build(&dir, &["--board", "zybo-z7-10"]));
     let sources: Vec<String> = ["snapgen_core.v", "snapgen_io.v", "snapgen_axi.v"]
         .map(String::from)
         .to_vec();
@@ -459,12 +451,16 @@ fn check(dir: &Path) {
     }
 }
 
+/// `snapgen build --host ps --out OUT` with `args`.
+fn ps_build(out: &Path, args: &[&str]) -> std::process::Output {
+    let mut all = vec!["build", "--host", "ps", "--out", out.to_str().unwrap()];
+    all.extend_from_slice(args);
+    snapgen(&all)
+}
+
 /// `snapgen build --host ps` with `args`, refused with a message containing `says`.
 fn refused(args: &[&str], says: &str) {
-    let out_dir = tmp("refused");
-    let mut all = vec!["build", "--host", "ps", "--out", out_dir.to_str().unwrap()];
-    all.extend_from_slice(args);
-    let out = snapgen(&all);
+    let out = ps_build(&tmp("refused"), args);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains(says),
@@ -482,17 +478,10 @@ fn the_ps_build_needs_a_zynq_and_a_clock_it_can_make() {
     );
     // 1000 MHz / 125 MHz = 8: the script asks the PS for 125 MHz.
     let dir = tmp("125");
-    snapgen_ok(&[
-        "build",
-        "--board",
-        "zybo-z7-10",
-        "--host",
-        "ps",
-        "--clock-hz",
-        "125e6",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    assert_ok(&ps_build(
+        &dir,
+        &["--board", "zybo-z7-10", "--clock-hz", "125e6"],
+    ));
     let bd = std::fs::read_to_string(dir.join("block_design.tcl")).unwrap();
     assert!(
         bd.contains("CONFIG.PCW_FPGA0_PERIPHERAL_FREQMHZ {125}"),

@@ -154,35 +154,43 @@ fn step_failed(exe: &Path, out: &std::process::Output, log: &Path) -> anyhow::Er
     )
 }
 
+/// The routed report in step `s`'s log when `s` is nextpnr's (checked for the design's clock),
+/// else none.
+fn nextpnr_report(s: &Step, log: &Path, clock_hz: u64) -> anyhow::Result<Option<Routed>> {
+    if s.tool != Tool::Nextpnr {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(log).unwrap_or_default();
+    let Some(r) = parse_nextpnr_log(&text) else {
+        return Ok(None);
+    };
+    check_target(&r, clock_hz)?;
+    Ok(Some(r))
+}
+
 /// Runs the build in `dir` (its files written): every step, its log kept; fails when a tool
 /// fails or routed timing does not close at the board's clock. Returns the routed report.
 pub fn run(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result<Routed> {
+    let mut routed = None;
     for s in steps {
         let (exe, out) = run_step(s, dir)?;
         let log = dir.join(&s.log);
-        if s.tool == Tool::Nextpnr {
-            let text = std::fs::read_to_string(&log).unwrap_or_default();
-            if let Some(r) = parse_nextpnr_log(&text) {
-                check_target(&r, clock_hz)?;
-                if !r.pass {
-                    bail!(
-                        "routed timing does not close: {:.2} MHz routed for the {:.2} MHz fabric clock (nextpnr's log: {})",
-                        r.fmax_mhz,
-                        r.target_mhz,
-                        log.display()
-                    );
-                }
+        if let Some(r) = nextpnr_report(s, &log, clock_hz)? {
+            if !r.pass {
+                bail!(
+                    "routed timing does not close: {:.2} MHz routed for the {:.2} MHz fabric clock (nextpnr's log: {})",
+                    r.fmax_mhz,
+                    r.target_mhz,
+                    log.display()
+                );
             }
+            routed = Some(r);
         }
         if !out.status.success() {
             return Err(step_failed(&exe, &out, &log));
         }
     }
-    let text = std::fs::read_to_string(dir.join("nextpnr.log")).context("nextpnr.log")?;
-    let r = parse_nextpnr_log(&text)
-        .context("nextpnr's log has no routed timing report (Max frequency for clock …)")?;
-    check_target(&r, clock_hz)?;
-    Ok(r)
+    routed.context("nextpnr's log has no routed timing report (Max frequency for clock …)")
 }
 
 /// Synthesises, places and routes (the steps up to nextpnr's; no bitstream) and returns the
@@ -191,12 +199,8 @@ pub fn route_report(steps: &[Step], dir: &Path, clock_hz: u64) -> anyhow::Result
     for s in steps.iter().filter(|s| s.tool != Tool::Ecppack) {
         let (exe, out) = run_step(s, dir)?;
         let log = dir.join(&s.log);
-        if s.tool == Tool::Nextpnr {
-            let text = std::fs::read_to_string(&log).unwrap_or_default();
-            if let Some(r) = parse_nextpnr_log(&text) {
-                check_target(&r, clock_hz)?;
-                return Ok(r);
-            }
+        if let Some(r) = nextpnr_report(s, &log, clock_hz)? {
+            return Ok(r);
         }
         if !out.status.success() {
             return Err(step_failed(&exe, &out, &log));
