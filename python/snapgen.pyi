@@ -1,13 +1,14 @@
 """snapgen: moves exact on the integer chain of the snapgen FPGA core.
 
 plan / plan_duration: rest-to-rest moves; replan: seed 002's online planner from any exact
-state; Board: a board (virtual or on a serial port) that runs moves as `snapgen send` does.
+state; Board: a board (virtual, on a serial port, or a Zynq's station through UIO) that runs
+moves as `snapgen send` does and timed PLCopen scripts as `snapgen online` does.
 The state at time t is the state after the last tick k with k * ts <= t, clamped to the move
 (the fabric's output holds between ticks). Positions are in units from the start, velocities
 in units/s, ...
 """
 
-from typing import Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -122,18 +123,88 @@ class MoveReport:
     warnings: List[str]
     """What the host warned about (stop limits)."""
 
+class CommandOutcome:
+    """What became of a command of a played script."""
+
+    event: int
+    """The event's index in the script."""
+    at_ms: float
+    """Its time (ms from the script's start)."""
+    command: str
+    """MC_MoveAbsolute, MC_MoveVelocity or MC_Halt."""
+    outcome: str
+    """Done, CommandAborted, Busy, Active, InVelocity, Error (NotGiven: its position was never
+    reached)."""
+    error_id: Optional[str]
+    """Its ErrorID when refused."""
+    note: Optional[str]
+    """What the axis noted about it."""
+    latency_ms: Optional[float]
+    """From the tick it was due to the first tick that obeyed it (ms), when it had one."""
+
+class OverrideOutcome:
+    """What became of a feed-override change of a played script."""
+
+    event: int
+    at_ms: float
+    factor: float
+    """The feed override (0-2)."""
+    error_id: Optional[str]
+    """Refused (its ErrorID), or taken."""
+    latency_ms: Optional[float]
+
+class OnlineReport:
+    """What Board.play did."""
+
+    commands: List[CommandOutcome]
+    overrides: List[OverrideOutcome]
+    replans: int
+    """Program swaps."""
+    extension_swaps: int
+    """More swaps that uploaded the rest of a change longer than the program memory."""
+    ticks: int
+    """Ticks from the script's start to its last state read."""
+    end_registers: Tuple[int, int, int, int]
+    """The board's raw (x, v, a, j) at its last state read."""
+    end_lsb: int
+    """Its position (output LSBs)."""
+    target_lsb: Optional[int]
+    """Where the last command not refused ends (output LSBs), if on a position."""
+    state_checks: int
+    """States read back and compared bit for bit with the host's prediction."""
+    warnings: List[str]
+    """What the stop-limit rule warned about."""
+
 class Board:
-    """A board behind the host's session: virtual (time in its own clocks) or on a serial port."""
+    """A board behind the host's session: virtual (time in its own clocks), on a serial port, or
+    a Zynq's station through its UIO device."""
 
     @staticmethod
     def model(*, baud: int = 115200, lsb: float = ...) -> "Board":
         """The device model (the I/O top's clock-accurate twin) as a virtual board."""
     @staticmethod
     def fabric(*, baud: int = 115200, lsb: float = ...) -> "Board":
-        """The Verilated I/O top as a virtual board (needs Verilator and a C++ compiler)."""
+        """The Verilated I/O top with the device model in lockstep (needs Verilator and a C++
+        compiler)."""
+    @staticmethod
+    def axi_model(*, lsb: float = ...) -> "Board":
+        """The AXI4-Lite top's model through the host's UIO link on a simulated memory map."""
+    @staticmethod
+    def axi_fabric(*, lsb: float = ...) -> "Board":
+        """The Verilated AXI4-Lite top, its model in lockstep, through the UIO link's code."""
     @staticmethod
     def serial(port: str, *, baud: int = 115200, lsb: float = ...) -> "Board":
         """A real board on a serial port."""
+    @staticmethod
+    def uio(path: str, *, lsb: float = ...) -> "Board":
+        """A Zynq's station through its UIO device (/dev/uioN; Linux only)."""
+    @property
+    def mismatches(self) -> Optional[int]:
+        """Clocks on which a Verilated top and its model in lockstep differed (None: no both)."""
+    def play(self, script: Union[str, Dict[str, Any]]) -> OnlineReport:
+        """Plays a timed script of PLCopen commands (TOML text or a dict; docs/ONLINE.md)
+        through the host axis, as `snapgen online` does; every state read is checked bit for
+        bit against the host's prediction."""
     @property
     def ts(self) -> float:
         """The board's tick period (s), read from it."""

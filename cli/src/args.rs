@@ -376,32 +376,16 @@ pub fn direct_link(
     baud: u32,
 ) -> Result<Option<DirectLink>, Failure> {
     Ok(match (port, uio) {
-        (_, Some(uio)) => Some((Box::new(open_uio(uio)?), RunOptions::memory_mapped())),
+        (_, Some(uio)) => Some((
+            snapgen_host::uio::open_station(uio)?,
+            RunOptions::memory_mapped(),
+        )),
         (Some(port), None) => Some((
             Box::new(SerialTransport::open(port, baud)?),
             RunOptions::default(),
         )),
         (None, None) => None,
     })
-}
-
-/// The station behind the UIO device `path` (Linux only).
-#[cfg(target_os = "linux")]
-pub fn open_uio(
-    path: &Path,
-) -> Result<snapgen_host::uio::RegisterTransport<snapgen_host::uio::Uio>, Failure> {
-    let regs = snapgen_host::uio::Uio::open(path)?;
-    Ok(snapgen_host::uio::RegisterTransport::open(regs)?)
-}
-
-/// The station behind a UIO device: Linux only.
-#[cfg(not(target_os = "linux"))]
-pub fn open_uio(path: &Path) -> Result<SerialTransport, Failure> {
-    Err(LinkError::Io(format!(
-        "--uio {}: UIO devices are Linux's (a Zynq running Linux)",
-        path.display()
-    ))
-    .into())
 }
 
 impl PlanArgs {

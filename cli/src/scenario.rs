@@ -17,7 +17,7 @@
 use snapgen_host::axis::{BufferMode, MotionCommand};
 use snapgen_host::driver::{Action, Event};
 
-use crate::commands::online::Script;
+use snapgen_host::online::Script;
 
 /// A built-in scenario.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

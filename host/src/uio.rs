@@ -318,3 +318,19 @@ impl Drop for Uio {
         let _ = unsafe { nix::sys::mman::munmap(self.base.cast(), self.len) };
     }
 }
+
+/// The station behind the UIO device `path` (`/dev/uioN`), checked and ready for the framed
+/// protocol: what `--uio` and Python's `Board.uio` open.
+#[cfg(target_os = "linux")]
+pub fn open_station(path: &std::path::Path) -> Result<Box<dyn Transport>, LinkError> {
+    Ok(Box::new(RegisterTransport::open(Uio::open(path)?)?))
+}
+
+/// UIO devices are Linux's.
+#[cfg(not(target_os = "linux"))]
+pub fn open_station(path: &std::path::Path) -> Result<Box<dyn Transport>, LinkError> {
+    Err(LinkError::Io(format!(
+        "{}: UIO devices are Linux's (a Zynq running Linux)",
+        path.display()
+    )))
+}

@@ -432,6 +432,9 @@ fn snapgen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
     m.add_class::<board::Board>()?;
     m.add_class::<board::MoveReport>()?;
+    m.add_class::<board::OnlineReport>()?;
+    m.add_class::<board::CommandOutcome>()?;
+    m.add_class::<board::OverrideOutcome>()?;
     m.add("BoardError", m.py().get_type::<board::BoardError>())?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_function(wrap_pyfunction!(plan_duration, m)?)?;

@@ -283,14 +283,19 @@ impl AxiBoard {
     }
 }
 
-/// The host's link to `board` over its registers: the framed protocol with the one retry
-/// policy, sequence numbers from 0 (a simulation repeats). Fails unless the board's `ID` and
-/// `VERSION` are this host's (the board is reset first).
-pub fn axi_link(mut board: AxiBoard) -> Result<FramedLink<RegisterTransport<AxiBoard>>, LinkError> {
+/// The host's medium to `board`: its registers (the UIO link's code up to the `mmap`). Fails
+/// unless the board's `ID` and `VERSION` are this host's (the board is reset first).
+pub fn axi_transport(mut board: AxiBoard) -> Result<RegisterTransport<AxiBoard>, LinkError> {
     // Power-up: the reset the peer gives, then a few clocks.
     board.idle(16);
+    RegisterTransport::open(board)
+}
+
+/// The host's link to `board` over its registers ([`axi_transport`]): the framed protocol
+/// with the one retry policy, sequence numbers from 0 (a simulation repeats).
+pub fn axi_link(board: AxiBoard) -> Result<FramedLink<RegisterTransport<AxiBoard>>, LinkError> {
     Ok(FramedLink::new(
-        RegisterTransport::open(board)?,
+        axi_transport(board)?,
         RetryPolicy::default(),
         0,
     ))

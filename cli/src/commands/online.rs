@@ -26,17 +26,18 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{ensure, Context};
-use serde::{Deserialize, Serialize};
-use snapgen_host::axis::{Goal, MotionCommand, Outcome};
-use snapgen_host::driver::{Action, Event, RunOptions, RunReport};
+use anyhow::Context;
+use serde::Serialize;
+use snapgen_host::driver::{RunOptions, RunReport};
 use snapgen_host::link::{FramedLink, Link, RetryPolicy};
-use snapgen_host::online::{play as play_script, PlayError, PlayOptions};
+use snapgen_host::online::{
+    command_lines, override_lines, play as play_script, target_lsb, CommandLine, OverrideLine,
+    PlayError, Script,
+};
 use snapgen_host::serial::session_seq;
 use snapgen_host::session::Session;
 use snapgen_model::device::Design;
 use snapgen_model::{Trace, DEFAULT_FORMAT};
-use snapgen_plan::online::OnlineOrder;
 use snapgen_sim::axi_board::{axi_link, AxiBoard};
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
@@ -93,7 +94,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (script, title) = match (a.script, a.scenario) {
         (Some(path), _) => {
             let title = format!("snapgen online {}", path.display());
-            (Script::read(&path).map_err(InputError::Script)?, title)
+            (read_script(&path).map_err(InputError::Script)?, title)
         }
         (None, Some(s)) => (
             s.script(a.jerk).map_err(InputError::Script)?,
@@ -125,86 +126,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A script file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Script {
-    /// Profile order: 3 or 2.
-    #[serde(default = "three")]
-    pub order: u8,
-    /// The board's controlled stop: deceleration (unit/s²) [default: the largest of the
-    /// script].
-    #[serde(default)]
-    pub stop_deceleration: Option<f64>,
-    /// Its jerk (unit/s³) [default: the largest of the script].
-    #[serde(default)]
-    pub stop_jerk: Option<f64>,
-    /// The events, in time order.
-    #[serde(rename = "event")]
-    pub events: Vec<Event>,
-}
-
-fn three() -> u8 {
-    3
-}
-
-impl Script {
-    /// Reads and checks a script file.
-    pub fn read(path: &Path) -> anyhow::Result<Script> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read the script {}", path.display()))?;
-        let s: Script = toml::from_str(&text).with_context(|| {
-            format!("{} is not a valid script (docs/ONLINE.md)", path.display())
-        })?;
-        s.check()?;
-        Ok(s)
-    }
-
-    /// Times in order and not negative, an order of 3 or 2, at least one event.
-    pub fn check(&self) -> anyhow::Result<()> {
-        ensure!(!self.events.is_empty(), "the script has no [[event]]");
-        ensure!(
-            matches!(self.order, 2 | 3),
-            "order = {}: give 3 (jerk-limited) or 2 (trapezoid)",
-            self.order
-        );
-        let mut last = 0.0;
-        for (k, e) in self.events.iter().enumerate() {
-            ensure!(
-                e.at_ms.is_finite() && e.at_ms >= last,
-                "event {k}: at_ms = {} must be finite, ≥ 0 and not before the event before it",
-                e.at_ms
-            );
-            last = e.at_ms;
-            let on_path = matches!(
-                e.action,
-                Action::Command(MotionCommand::MoveAbsolute { path: Some(_), .. })
-            );
-            ensure!(
-                !on_path,
-                "event {k}: `path` (an element's caps) is set by `snapgen path`, not by a script: remove it"
-            );
-        }
-        Ok(())
-    }
-
-    fn order(&self) -> OnlineOrder {
-        if self.order == 2 {
-            OnlineOrder::Two
-        } else {
-            OnlineOrder::Three
-        }
-    }
-
-    /// How the host plays it, with the run options `run` (the link's).
-    fn options(&self, run: RunOptions) -> PlayOptions {
-        PlayOptions {
-            order: self.order(),
-            stop_deceleration: self.stop_deceleration,
-            stop_jerk: self.stop_jerk,
-            run,
-        }
-    }
+/// Reads and checks a script file.
+pub fn read_script(path: &Path) -> anyhow::Result<Script> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read the script {}", path.display()))?;
+    Script::from_toml(&text).with_context(|| format!("the script {}", path.display()))
 }
 
 /// Which board.
@@ -314,32 +240,6 @@ pub fn design(baud: u32) -> anyhow::Result<Design> {
     snapgen_sim::board::virtual_design(baud).with_context(|| format!("a board at {baud} baud"))
 }
 
-/// One command's line in the JSON.
-#[derive(Serialize)]
-struct CommandJson {
-    event: usize,
-    at_ms: f64,
-    command: &'static str,
-    outcome: &'static str,
-    error_id: Option<String>,
-    note: Option<String>,
-    /// Ticks from the event to the first tick that obeyed it (its swap), when it had one.
-    latency_ms: Option<f64>,
-}
-
-/// One override change's line in the JSON.
-#[derive(Serialize)]
-struct OverrideJson {
-    event: usize,
-    at_ms: f64,
-    /// The feed override (0–2).
-    factor: f64,
-    /// Refused (its ErrorID), or taken.
-    error_id: Option<String>,
-    /// Ticks from the event to the first tick that obeyed it (its swap), when it had one.
-    latency_ms: Option<f64>,
-}
-
 /// The registers, as decimal strings (they exceed 64 bits).
 #[derive(Serialize)]
 struct Raw {
@@ -352,8 +252,8 @@ struct Raw {
 /// `--json`'s object.
 #[derive(Serialize)]
 struct Json {
-    commands: Vec<CommandJson>,
-    overrides: Vec<OverrideJson>,
+    commands: Vec<CommandLine>,
+    overrides: Vec<OverrideLine>,
     refused_overrides: Vec<(usize, String)>,
     replans: usize,
     extension_swaps: u32,
@@ -367,108 +267,13 @@ struct Json {
     clocks: Option<u64>,
 }
 
-/// The position a command ends on (output LSBs), if it does.
-fn target_lsb(p: &Played) -> Option<i128> {
-    let axis = &p.report.axis;
-    let last = axis
-        .commands
-        .iter()
-        .rposition(|c| !matches!(c.outcome, Outcome::Error(_)))?;
-    axis.timeline
-        .parts
-        .iter()
-        .rev()
-        .find(|q| q.command == last && !q.cut)
-        .and_then(|q| match q.goal {
-            Goal::Position {
-                cell,
-                velocity: 0.0,
-            } => Some(cell),
-            _ => None,
-        })
-}
-
-/// The latency of event `k` (ms): from its due tick to the swap that realised it.
-fn latency_ms(p: &Played, k: usize) -> Option<f64> {
-    let r = &p.report;
-    let due = *r.event_ticks.get(k)?;
-    r.swaps
-        .iter()
-        .find(|s| s.events.contains(&k))
-        .map(|s| s.tick.saturating_sub(due) as f64 * r.axis.settings.format.ts * 1e3)
-}
-
-fn override_lines(p: &Played) -> Vec<OverrideJson> {
-    let r = &p.report;
-    let mut out = Vec::new();
-    for (k, e) in p.script.events.iter().enumerate() {
-        let Action::Override { r#override } = e.action else {
-            continue;
-        };
-        if r.event_ticks.get(k).is_none() {
-            continue;
-        }
-        out.push(OverrideJson {
-            event: k,
-            at_ms: e.at_ms,
-            factor: r#override,
-            error_id: r
-                .refused_overrides
-                .iter()
-                .find(|(ev, _)| *ev == k)
-                .map(|(_, id)| id.to_string()),
-            latency_ms: latency_ms(p, k),
-        });
-    }
-    out
-}
-
-fn command_lines(p: &Played) -> Vec<CommandJson> {
-    let r = &p.report;
-    let mut out = Vec::new();
-    for (k, e) in p.script.events.iter().enumerate() {
-        let Some(taken) = r.event_commands.get(k) else {
-            if let Action::Command(c) = e.action {
-                out.push(CommandJson {
-                    event: k,
-                    at_ms: e.at_ms,
-                    command: c.name(),
-                    outcome: "NotGiven",
-                    error_id: None,
-                    note: Some("its position was not reached before the run ended".into()),
-                    latency_ms: None,
-                });
-            }
-            continue;
-        };
-        let Some(c) = taken else {
-            continue;
-        };
-        let rec = &r.axis.commands[*c];
-        let latency = latency_ms(p, k);
-        out.push(CommandJson {
-            event: k,
-            at_ms: e.at_ms,
-            command: rec.command.name(),
-            outcome: rec.outcome.name(),
-            error_id: match &rec.outcome {
-                Outcome::Error(id) => Some(id.to_string()),
-                _ => None,
-            },
-            note: rec.note.clone(),
-            latency_ms: latency,
-        });
-    }
-    out
-}
-
 /// The `--json` object.
 pub fn json(p: &Played) -> String {
     let r = &p.report;
     let f = r.axis.settings.format;
     let j = Json {
-        commands: command_lines(p),
-        overrides: override_lines(p),
+        commands: command_lines(r, &p.script.events),
+        overrides: override_lines(r, &p.script.events),
         refused_overrides: r
             .refused_overrides
             .iter()
@@ -479,7 +284,7 @@ pub fn json(p: &Played) -> String {
         ticks: r.last.ticks - r.start_tick,
         ts: f.ts,
         final_lsb: f.output_lsb(r.last.x),
-        target_lsb: target_lsb(p),
+        target_lsb: target_lsb(r),
         final_raw: Raw {
             x: r.last.x.to_string(),
             v: r.last.v.to_string(),
@@ -498,7 +303,7 @@ pub fn describe(p: &Played) -> String {
     let r = &p.report;
     let f = r.axis.settings.format;
     let mut s = String::new();
-    for c in command_lines(p) {
+    for c in command_lines(r, &p.script.events) {
         s += &format!(
             "  event {:>2} at {:>8.1} ms  {:<16} {:<15}{}{}{}\n",
             c.event,
@@ -512,7 +317,7 @@ pub fn describe(p: &Played) -> String {
             c.note.map_or(String::new(), |n| format!(" ({n})")),
         );
     }
-    for o in override_lines(p) {
+    for o in override_lines(r, &p.script.events) {
         s += &format!(
             "  event {:>2} at {:>8.1} ms  override {:<7} {}\n",
             o.event,
@@ -536,7 +341,7 @@ pub fn describe(p: &Played) -> String {
     s += &format!(
         "  final position {} LSB{}, registers x={} v={} a={} j={}",
         f.output_lsb(r.last.x),
-        target_lsb(p).map_or(String::new(), |t| format!(" (target {t})")),
+        target_lsb(r).map_or(String::new(), |t| format!(" (target {t})")),
         r.last.x,
         r.last.v,
         r.last.a,
@@ -593,32 +398,4 @@ pub fn write_svg(p: &Played, title: &str, path: &Path) -> anyhow::Result<()> {
         .collect();
     crate::svg::write_program_svg(&program, t.origin.1, &f, title, &events, path)
         .map_err(|e| anyhow::anyhow!("cannot draw {}: {e}", path.display()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use snapgen_host::axis::MotionCommand;
-
-    /// The script format's example in docs/ONLINE.md parses, passes the checks, and holds
-    /// every kind of event.
-    #[test]
-    fn the_documented_script_is_valid() {
-        let doc = include_str!("../../../docs/ONLINE.md");
-        let start = doc.find("```toml\n").expect("a TOML block") + 8;
-        let len = doc[start..].find("```").unwrap();
-        let s: Script = toml::from_str(&doc[start..start + len]).unwrap();
-        s.check().unwrap();
-        assert_eq!(s.events.len(), 4);
-        assert!(matches!(
-            s.events[0].action,
-            Action::Command(MotionCommand::MoveAbsolute { .. })
-        ));
-        assert!(matches!(s.events[1].action, Action::Override { .. }));
-        assert_eq!(s.events[2].at_position, Some(300.0));
-        assert!(matches!(
-            s.events[3].action,
-            Action::Command(MotionCommand::Halt { .. })
-        ));
-    }
 }
