@@ -10,6 +10,8 @@ in units/s, ...
 
 from typing import Any, Dict, List, Optional, Tuple, Union
 
+import os
+
 import numpy as np
 import numpy.typing as npt
 
@@ -196,7 +198,7 @@ class Board:
     def serial(port: str, *, baud: int = 115200, lsb: float = ...) -> "Board":
         """A real board on a serial port."""
     @staticmethod
-    def uio(path: str, *, lsb: float = ...) -> "Board":
+    def uio(path: Union[str, "os.PathLike[str]"], *, lsb: float = ...) -> "Board":
         """A Zynq's station through its UIO device (/dev/uioN; Linux only)."""
     @property
     def mismatches(self) -> Optional[int]:
@@ -204,7 +206,10 @@ class Board:
     def play(self, script: Union[str, Dict[str, Any]]) -> OnlineReport:
         """Plays a timed script of PLCopen commands (TOML text or a dict; docs/ONLINE.md)
         through the host axis, as `snapgen online` does; every state read is checked bit for
-        bit against the host's prediction."""
+        bit against the host's prediction, and on fabric boards the Verilated top against its
+        model on every clock (BoardError when either differs). A script that breaks a rule
+        raises PlanError; a dict JSON cannot encode, TypeError. A str is the script's text,
+        not a file name."""
     @property
     def ts(self) -> float:
         """The board's tick period (s), read from it."""

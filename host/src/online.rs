@@ -395,6 +395,14 @@ mod tests {
             Err(ScriptError::NoEvents)
         );
         assert!(matches!(
+            Script::from_json(r#"{"event": [{"at_ms": -1.0, "override": 1.0}]}"#),
+            Err(ScriptError::Time { event: 0, .. })
+        ));
+        let on_path = r#"{"event": [{"at_ms": 0.0, "kind": "move_absolute", "position": 1.0,
+            "velocity": 1.0, "acceleration": 1.0, "deceleration": 1.0, "jerk": 1.0,
+            "path": {"velocity": 1.0, "entry": 1.0}}]}"#;
+        assert_eq!(Script::from_json(on_path), Err(ScriptError::PathCaps(0)));
+        assert!(matches!(
             Script::from_toml(&format!("speed = 1\n{ok}")),
             Err(ScriptError::Syntax(_))
         ));

@@ -15,7 +15,7 @@ use snapgen_host::link::{FramedLink, LinkError, RetryPolicy, Transport};
 use snapgen_host::online::{self, PlayError, Script};
 use snapgen_host::protocol::Command;
 use snapgen_host::send::{send_move, NoProgress, SendOptions};
-use snapgen_host::serial::SerialTransport;
+use snapgen_host::serial::{session_seq, SerialTransport};
 use snapgen_host::session::{Failure, Session};
 use snapgen_host::uio::RegisterTransport;
 use snapgen_model::device::Design;
@@ -176,24 +176,26 @@ pub struct MoveReport {
     warnings: Vec<String>,
 }
 
-fn open(transport: Medium, lsb: f64) -> PyResult<Board> {
+/// A session with the board behind `transport`: the driver's run options `run` for its medium
+/// (a memory-mapped one needs less lead), `lockstep` when a Verilated top runs beside its model.
+fn open(transport: Medium, run: RunOptions, lockstep: bool, lsb: f64) -> PyResult<Board> {
     if !(lsb.is_finite() && lsb > 0.0) {
         return Err(PlanError::new_err(format!(
             "lsb = {lsb}: give the size of one output position LSB in units (> 0)"
         )));
     }
-    let run = match transport {
-        Medium::Uart(_) => RunOptions::default(),
-        Medium::Axi(_) => RunOptions::memory_mapped(),
-        // A real board's medium says itself below.
-        Medium::Direct(_) => RunOptions::default(),
+    // A real board's sequence numbers start where no earlier session's did (the CLI's rule); a
+    // simulation repeats from 0.
+    let seq = match transport {
+        Medium::Direct(_) => session_seq(),
+        _ => 0,
     };
-    let link = FramedLink::new(transport, RetryPolicy::default(), 0);
+    let link = FramedLink::new(transport, RetryPolicy::default(), seq);
     let session = Session::open(link, lsb).map_err(failure)?;
     Ok(Board {
         session,
         run,
-        lockstep: false,
+        lockstep,
     })
 }
 
@@ -201,6 +203,31 @@ fn open(transport: Medium, lsb: f64) -> PyResult<Board> {
 fn design(baud: u32) -> PyResult<Design> {
     snapgen_sim::board::virtual_design(baud)
         .map_err(|e| PlanError::new_err(format!("a board at {baud} baud: {e}")))
+}
+
+impl Board {
+    /// On a board with a Verilated top and its model in lockstep, a `BoardError` when they have
+    /// differed on any clock (the promise is none; the CLI exits 1 the same way).
+    fn check_lockstep(&self) -> PyResult<()> {
+        let (n, first) = match self.session.link.transport() {
+            Medium::Uart(t) if self.lockstep => (
+                t.board().mismatches(),
+                t.board().first_mismatch().map(|m| format!("{m:?}")),
+            ),
+            Medium::Axi(t) if self.lockstep => (
+                t.registers().mismatches(),
+                t.registers().first_mismatch().map(|m| m.to_string()),
+            ),
+            _ => return Ok(()),
+        };
+        if n == 0 {
+            return Ok(());
+        }
+        Err(BoardError::new_err(format!(
+            "the Verilated top and its model differed on {n} clocks, the first: {}",
+            first.unwrap_or_default()
+        )))
+    }
 }
 
 #[pymethods]
@@ -211,7 +238,12 @@ impl Board {
     #[pyo3(signature = (*, baud=115_200, lsb=DEFAULT_FORMAT.position_lsb))]
     fn model(baud: u32, lsb: f64) -> PyResult<Board> {
         let board = VirtualBoard::model(&design(baud)?);
-        open(Medium::Uart(Box::new(BoardTransport::new(board))), lsb)
+        open(
+            Medium::Uart(Box::new(BoardTransport::new(board))),
+            RunOptions::default(),
+            false,
+            lsb,
+        )
     }
 
     /// A virtual board running the Verilated I/O top, the device model in lockstep (every
@@ -222,9 +254,12 @@ impl Board {
     fn fabric(baud: u32, lsb: f64) -> PyResult<Board> {
         let board = VirtualBoard::lockstep(&design(baud)?)
             .map_err(|e| BoardError::new_err(format!("cannot build the Verilated I/O top: {e}")))?;
-        let mut b = open(Medium::Uart(Box::new(BoardTransport::new(board))), lsb)?;
-        b.lockstep = true;
-        Ok(b)
+        open(
+            Medium::Uart(Box::new(BoardTransport::new(board))),
+            RunOptions::default(),
+            true,
+            lsb,
+        )
     }
 
     /// A real board on serial port `port` at `baud` (its UART's rate).
@@ -233,7 +268,12 @@ impl Board {
     fn serial(port: &str, baud: u32, lsb: f64) -> PyResult<Board> {
         let t =
             SerialTransport::open(port, baud).map_err(|e| BoardError::new_err(e.to_string()))?;
-        open(Medium::Direct(Box::new(t)), lsb)
+        open(
+            Medium::Direct(Box::new(t)),
+            RunOptions::default(),
+            false,
+            lsb,
+        )
     }
 
     /// A virtual board running the AXI4-Lite top's model (the station's registers, the same
@@ -244,7 +284,12 @@ impl Board {
     fn axi_model(lsb: f64) -> PyResult<Board> {
         let board = AxiBoard::model(&design(115_200)?);
         let t = axi_transport(board).map_err(|e| BoardError::new_err(e.to_string()))?;
-        open(Medium::Axi(Box::new(t)), lsb)
+        open(
+            Medium::Axi(Box::new(t)),
+            RunOptions::memory_mapped(),
+            false,
+            lsb,
+        )
     }
 
     /// The Verilated AXI4-Lite top with its model in lockstep (every output of every clock
@@ -257,9 +302,12 @@ impl Board {
             BoardError::new_err(format!("cannot build the Verilated AXI4-Lite top: {e}"))
         })?;
         let t = axi_transport(board).map_err(|e| BoardError::new_err(e.to_string()))?;
-        let mut b = open(Medium::Axi(Box::new(t)), lsb)?;
-        b.lockstep = true;
-        Ok(b)
+        open(
+            Medium::Axi(Box::new(t)),
+            RunOptions::memory_mapped(),
+            true,
+            lsb,
+        )
     }
 
     /// A real board's station through its UIO device (`/dev/uioN`, on a Zynq running the
@@ -269,9 +317,7 @@ impl Board {
     fn uio(path: std::path::PathBuf, lsb: f64) -> PyResult<Board> {
         let t = snapgen_host::uio::open_station(&path)
             .map_err(|e| BoardError::new_err(e.to_string()))?;
-        let mut b = open(Medium::Direct(t), lsb)?;
-        b.run = RunOptions::memory_mapped();
-        Ok(b)
+        open(Medium::Direct(t), RunOptions::memory_mapped(), false, lsb)
     }
 
     /// Clocks on which the Verilated top and its model in lockstep differed (`fabric`,
@@ -296,7 +342,9 @@ impl Board {
     /// limits are written (the script's, or its largest deceleration and jerk), the axis
     /// powered, every change planned from the exact state at a swap tick, uploaded and armed;
     /// every state read back is compared bit for bit with the host's prediction (a difference
-    /// stops the axis and raises `BoardError`).
+    /// stops the axis and raises `BoardError`), and on `fabric` and `axi_fabric` boards the
+    /// Verilated top with its model on every clock (`BoardError` when they differed). A script
+    /// that breaks a rule raises `PlanError`.
     fn play(&mut self, py: Python<'_>, script: &Bound<'_, PyAny>) -> PyResult<OnlineReport> {
         let script = if let Ok(text) = script.extract::<String>() {
             Script::from_toml(&text)
@@ -315,6 +363,7 @@ impl Board {
                     e => BoardError::new_err(e.to_string()),
                 },
             )?;
+        self.check_lockstep()?;
         let f = r.axis.settings.format;
         Ok(OnlineReport {
             commands: online::command_lines(&r, &script.events)
@@ -427,6 +476,7 @@ impl Board {
         };
         let request = MoveRequest { distance, method };
         let r = send_move(&mut self.session, &request, &opts, &mut NoProgress).map_err(failure)?;
+        self.check_lockstep()?;
         Ok(MoveReport {
             trajectory: Py::new(py, Trajectory::from(r.plan))?,
             end_registers: (r.state.x, r.state.v, r.state.a, r.state.j),

@@ -71,6 +71,7 @@ jerk = 200000.0
     assert [c.outcome for c in a.commands] == ["Done"]
 
 
+@pytest.mark.verilated
 def test_the_verilated_axi_top_agrees_with_its_model_on_every_clock():
     board = snapgen.Board.axi_fabric()
     r = board.play(script(target=2.0))

@@ -130,7 +130,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 pub fn read_script(path: &Path) -> anyhow::Result<Script> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read the script {}", path.display()))?;
-    Script::from_toml(&text).with_context(|| format!("the script {}", path.display()))
+    Script::from_toml(&text).with_context(|| path.display().to_string())
 }
 
 /// Which board.
