@@ -138,9 +138,15 @@ class CommandOutcome:
     """Done, CommandAborted, Busy, Active, InVelocity, Error (NotGiven: its position was never
     reached)."""
     error_id: Optional[str]
-    """Its ErrorID when refused."""
+    """Its ErrorID when refused (invalid_input, planner, board, link_too_slow, diverged)."""
+    error: Optional[str]
+    """The refusal's message."""
     note: Optional[str]
     """What the axis noted about it."""
+    due_tick: Optional[int]
+    """The tick it was due on (its time, or when its position was reached), when taken."""
+    swap_tick: Optional[int]
+    """The tick of the swap that realised it (the first tick that obeyed it), if one did."""
     latency_ms: Optional[float]
     """From the tick it was due to the first tick that obeyed it (ms), when it had one."""
 
@@ -153,6 +159,9 @@ class OverrideOutcome:
     """The feed override (0-2)."""
     error_id: Optional[str]
     """Refused (its ErrorID), or taken."""
+    error: Optional[str]
+    due_tick: Optional[int]
+    swap_tick: Optional[int]
     latency_ms: Optional[float]
 
 class OnlineReport:

@@ -538,6 +538,14 @@ fn online_plays_a_script_and_reports_every_field() {
     assert!(overrides[0]["error_id"].is_null());
     let ms = overrides[0]["latency_ms"].as_f64().unwrap();
     assert!(ms > 0.0 && ms < 10.0, "override latency {ms} ms");
+    // Its due tick and the tick of the swap that realised it: the latency between them.
+    let (due, swap) = (
+        overrides[0]["due_tick"].as_u64().unwrap(),
+        overrides[0]["swap_tick"].as_u64().unwrap(),
+    );
+    assert!(swap > due);
+    let ts = j["ts"].as_f64().unwrap();
+    assert!(((swap - due) as f64 * ts * 1e3 - ms).abs() < 1e-9);
     assert!(j["refused_overrides"].as_array().unwrap().is_empty());
     assert!(j["replans"].as_u64().unwrap() >= 1);
     assert_eq!(j["final_lsb"], j["target_lsb"]);

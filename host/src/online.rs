@@ -10,7 +10,7 @@ use snapgen_model::format::{Format, Quantity};
 use snapgen_model::stop::StopLimits;
 use snapgen_plan::online::OnlineOrder;
 
-use crate::axis::{AxisSettings, Goal, MotionCommand, Outcome};
+use crate::axis::{AxisErrorId, AxisSettings, Goal, MotionCommand, Outcome};
 use crate::driver::{run, Action, Event, RunError, RunOptions, RunReport};
 use crate::limits::{stop_limits, LimitSource};
 use crate::link::Link;
@@ -227,10 +227,16 @@ pub struct CommandLine {
     /// Its outcome (`Done`, `CommandAborted`, `Busy`, `Active`, `InVelocity`, `Error`; `NotGiven`: its position was
     /// never reached).
     pub outcome: &'static str,
-    /// Its ErrorID when refused.
-    pub error_id: Option<String>,
+    /// Its ErrorID when refused (docs/ONLINE.md's names: `invalid_input`, `planner`, …).
+    pub error_id: Option<&'static str>,
+    /// The refusal's message.
+    pub error: Option<String>,
     /// What the axis noted about it.
     pub note: Option<String>,
+    /// The tick it was due on (its time, or when its position was reached), when it was taken.
+    pub due_tick: Option<u64>,
+    /// The tick of the swap that realised it (the first tick that obeyed it), when it had one.
+    pub swap_tick: Option<u64>,
     /// From the tick it was due to the first tick that obeyed it (its swap), when it had one.
     pub latency_ms: Option<f64>,
 }
@@ -245,18 +251,29 @@ pub struct OverrideLine {
     /// The feed override (0–2).
     pub factor: f64,
     /// Refused (its ErrorID), or taken.
-    pub error_id: Option<String>,
+    pub error_id: Option<&'static str>,
+    /// The refusal's message.
+    pub error: Option<String>,
+    /// The tick it was due on.
+    pub due_tick: Option<u64>,
+    /// The tick of the swap that realised it, when it had one.
+    pub swap_tick: Option<u64>,
     /// From the tick it was due to the first tick that obeyed it (its swap), when it had one.
     pub latency_ms: Option<f64>,
+}
+
+/// The tick of the swap that realised event `k`, if one did.
+pub fn swap_tick(r: &RunReport, k: usize) -> Option<u64> {
+    r.swaps
+        .iter()
+        .find(|s| s.events.contains(&k))
+        .map(|s| s.tick)
 }
 
 /// The latency of event `k` (ms): from its due tick to the swap that realised it.
 pub fn latency_ms(r: &RunReport, k: usize) -> Option<f64> {
     let due = *r.event_ticks.get(k)?;
-    r.swaps
-        .iter()
-        .find(|s| s.events.contains(&k))
-        .map(|s| s.tick.saturating_sub(due) as f64 * r.axis.settings.format.ts * 1e3)
+    swap_tick(r, k).map(|t| t.saturating_sub(due) as f64 * r.axis.settings.format.ts * 1e3)
 }
 
 /// What became of each command of `events` in the run `r`.
@@ -271,7 +288,10 @@ pub fn command_lines(r: &RunReport, events: &[Event]) -> Vec<CommandLine> {
                     command: c.name(),
                     outcome: "NotGiven",
                     error_id: None,
+                    error: None,
                     note: Some("its position was not reached before the run ended".into()),
+                    due_tick: None,
+                    swap_tick: None,
                     latency_ms: None,
                 });
             }
@@ -287,10 +307,16 @@ pub fn command_lines(r: &RunReport, events: &[Event]) -> Vec<CommandLine> {
             command: rec.command.name(),
             outcome: rec.outcome.name(),
             error_id: match &rec.outcome {
+                Outcome::Error(id) => Some(id.name()),
+                _ => None,
+            },
+            error: match &rec.outcome {
                 Outcome::Error(id) => Some(id.to_string()),
                 _ => None,
             },
             note: rec.note.clone(),
+            due_tick: r.event_ticks.get(k).copied(),
+            swap_tick: swap_tick(r, k),
             latency_ms: latency_ms(r, k),
         });
     }
@@ -307,15 +333,19 @@ pub fn override_lines(r: &RunReport, events: &[Event]) -> Vec<OverrideLine> {
         if r.event_ticks.get(k).is_none() {
             continue;
         }
+        let refused = r
+            .refused_overrides
+            .iter()
+            .find(|(ev, _)| *ev == k)
+            .map(|(_, id)| id);
         out.push(OverrideLine {
             event: k,
             at_ms: e.at_ms,
             factor: r#override,
-            error_id: r
-                .refused_overrides
-                .iter()
-                .find(|(ev, _)| *ev == k)
-                .map(|(_, id)| id.to_string()),
+            error_id: refused.map(AxisErrorId::name),
+            error: refused.map(|id| id.to_string()),
+            due_tick: r.event_ticks.get(k).copied(),
+            swap_tick: swap_tick(r, k),
             latency_ms: latency_ms(r, k),
         });
     }
@@ -370,6 +400,24 @@ mod tests {
         // The same script as JSON (what Python's dicts become) is the same script.
         let json = serde_json::to_string(&s).unwrap();
         assert_eq!(Script::from_json(&json).unwrap(), s);
+    }
+
+    /// The ErrorID names the summaries give are the ones the error's serialisation (and
+    /// docs/ONLINE.md) uses.
+    #[test]
+    fn error_id_names_are_the_serialised_tags() {
+        use crate::axis::AxisErrorId;
+        for id in [
+            AxisErrorId::Planner("p".into()),
+            AxisErrorId::InvalidInput("i".into()),
+            AxisErrorId::Board("b".into()),
+            AxisErrorId::LinkTooSlow { segments: 1 },
+            AxisErrorId::Diverged { tick: 1 },
+        ] {
+            let tag = serde_json::to_value(&id).unwrap()["error"].clone();
+            assert_eq!(tag, id.name(), "{id:?}");
+            assert!(include_str!("../../docs/ONLINE.md").contains(&format!("`{}`", id.name())));
+        }
     }
 
     #[test]

@@ -102,10 +102,17 @@ pub struct CommandOutcome {
     /// `Done`, `CommandAborted`, `Busy`, `Active`, `InVelocity`, `Error` (`NotGiven`: its
     /// position was never reached).
     outcome: &'static str,
-    /// Its ErrorID when refused.
-    error_id: Option<String>,
+    /// Its ErrorID when refused (`invalid_input`, `planner`, `board`, `link_too_slow`,
+    /// `diverged`: docs/ONLINE.md).
+    error_id: Option<&'static str>,
+    /// The refusal's message.
+    error: Option<String>,
     /// What the axis noted about it.
     note: Option<String>,
+    /// The tick it was due on (its time, or when its position was reached), when taken.
+    due_tick: Option<u64>,
+    /// The tick of the swap that realised it (the first tick that obeyed it), if one did.
+    swap_tick: Option<u64>,
     /// From the tick it was due to the first tick that obeyed it (ms), when it had one.
     latency_ms: Option<f64>,
 }
@@ -121,7 +128,13 @@ pub struct OverrideOutcome {
     /// The feed override (0–2).
     factor: f64,
     /// Refused (its ErrorID), or taken.
-    error_id: Option<String>,
+    error_id: Option<&'static str>,
+    /// The refusal's message.
+    error: Option<String>,
+    /// The tick it was due on.
+    due_tick: Option<u64>,
+    /// The tick of the swap that realised it, if one did.
+    swap_tick: Option<u64>,
     /// From the tick it was due to the first tick that obeyed it (ms), when it had one.
     latency_ms: Option<f64>,
 }
@@ -374,7 +387,10 @@ impl Board {
                     command: c.command,
                     outcome: c.outcome,
                     error_id: c.error_id,
+                    error: c.error,
                     note: c.note,
+                    due_tick: c.due_tick,
+                    swap_tick: c.swap_tick,
                     latency_ms: c.latency_ms,
                 })
                 .collect(),
@@ -385,6 +401,9 @@ impl Board {
                     at_ms: o.at_ms,
                     factor: o.factor,
                     error_id: o.error_id,
+                    error: o.error,
+                    due_tick: o.due_tick,
+                    swap_tick: o.swap_tick,
                     latency_ms: o.latency_ms,
                 })
                 .collect(),

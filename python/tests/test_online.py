@@ -89,3 +89,17 @@ def test_bad_scripts_and_a_missing_device():
         b.play("order = ")
     with pytest.raises(snapgen.BoardError, match="UIO"):
         snapgen.Board.uio("/nonexistent/uio0")
+
+
+def test_a_refused_override_names_its_error_id():
+    r = snapgen.Board.axi_model().play(
+        {"event": [dict(at_ms=0, kind="move_absolute", position=0.5, **MOVE),
+                   dict(at_ms=2, override=3.0)]}
+    )
+    (o,) = r.overrides
+    assert o.error_id == "invalid_input" and "0" in o.error and o.swap_tick is None
+    assert o.due_tick is not None and o.latency_ms is None
+    (c,) = r.commands
+    assert c.outcome == "Done" and c.error_id is None and c.swap_tick > c.due_tick
+    assert r.end_lsb == lsb_of(0.5)
+

@@ -254,7 +254,7 @@ struct Raw {
 struct Json {
     commands: Vec<CommandLine>,
     overrides: Vec<OverrideLine>,
-    refused_overrides: Vec<(usize, String)>,
+    refused_overrides: Vec<(usize, &'static str)>,
     replans: usize,
     extension_swaps: u32,
     ticks: u64,
@@ -277,7 +277,7 @@ pub fn json(p: &Played) -> String {
         refused_overrides: r
             .refused_overrides
             .iter()
-            .map(|(e, id)| (*e, id.to_string()))
+            .map(|(e, id)| (*e, id.name()))
             .collect(),
         replans: r.swaps.len(),
         extension_swaps: r.extensions,
@@ -312,8 +312,10 @@ pub fn describe(p: &Played) -> String {
             c.outcome,
             c.latency_ms
                 .map_or(String::new(), |l| format!(" latency {l:.2} ms")),
-            c.error_id
-                .map_or(String::new(), |e| format!(" ErrorID: {e}")),
+            match (c.error_id, &c.error) {
+                (Some(id), Some(m)) => format!(" ErrorID {id}: {m}"),
+                _ => String::new(),
+            },
             c.note.map_or(String::new(), |n| format!(" ({n})")),
         );
     }
@@ -323,8 +325,8 @@ pub fn describe(p: &Played) -> String {
             o.event,
             o.at_ms,
             format!("{:.0} %", o.factor * 100.0),
-            match (&o.error_id, o.latency_ms) {
-                (Some(id), _) => format!("refused: {id}"),
+            match (o.error_id, o.latency_ms) {
+                (Some(id), _) => format!("refused: {id}: {}", o.error.as_deref().unwrap_or("")),
                 (None, Some(l)) => format!("latency {l:.2} ms"),
                 (None, None) => "nothing to change".into(),
             }

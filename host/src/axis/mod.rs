@@ -182,6 +182,20 @@ pub enum AxisErrorId {
     },
 }
 
+impl AxisErrorId {
+    /// Its ErrorID as docs/ONLINE.md lists it (`invalid_input`, `planner`, `board`,
+    /// `link_too_slow`, `diverged`); the message is its `Display`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            AxisErrorId::Planner(_) => "planner",
+            AxisErrorId::InvalidInput(_) => "invalid_input",
+            AxisErrorId::Board(_) => "board",
+            AxisErrorId::LinkTooSlow { .. } => "link_too_slow",
+            AxisErrorId::Diverged { .. } => "diverged",
+        }
+    }
+}
+
 /// How a command ended, or where it stands.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
