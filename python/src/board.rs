@@ -212,6 +212,29 @@ fn open(transport: Medium, run: RunOptions, lockstep: bool, lsb: f64) -> PyResul
     })
 }
 
+/// A virtual board behind its UART (`lockstep`: a Verilated top beside its model).
+fn open_uart(board: VirtualBoard, lockstep: bool, lsb: f64) -> PyResult<Board> {
+    let t = BoardTransport::new(board);
+    open(
+        Medium::Uart(Box::new(t)),
+        RunOptions::default(),
+        lockstep,
+        lsb,
+    )
+}
+
+/// A virtual AXI board through the UIO link's code (`lockstep`: a Verilated top beside its
+/// model).
+fn open_axi(board: AxiBoard, lockstep: bool, lsb: f64) -> PyResult<Board> {
+    let t = axi_transport(board).map_err(|e| BoardError::new_err(e.to_string()))?;
+    open(
+        Medium::Axi(Box::new(t)),
+        RunOptions::memory_mapped(),
+        lockstep,
+        lsb,
+    )
+}
+
 /// A virtual board's design: the default clock and Ts at `baud`.
 fn design(baud: u32) -> PyResult<Design> {
     snapgen_sim::board::virtual_design(baud)
@@ -250,13 +273,7 @@ impl Board {
     #[staticmethod]
     #[pyo3(signature = (*, baud=115_200, lsb=DEFAULT_FORMAT.position_lsb))]
     fn model(baud: u32, lsb: f64) -> PyResult<Board> {
-        let board = VirtualBoard::model(&design(baud)?);
-        open(
-            Medium::Uart(Box::new(BoardTransport::new(board))),
-            RunOptions::default(),
-            false,
-            lsb,
-        )
+        open_uart(VirtualBoard::model(&design(baud)?), false, lsb)
     }
 
     /// A virtual board running the Verilated I/O top, the device model in lockstep (every
@@ -267,12 +284,7 @@ impl Board {
     fn fabric(baud: u32, lsb: f64) -> PyResult<Board> {
         let board = VirtualBoard::lockstep(&design(baud)?)
             .map_err(|e| BoardError::new_err(format!("cannot build the Verilated I/O top: {e}")))?;
-        open(
-            Medium::Uart(Box::new(BoardTransport::new(board))),
-            RunOptions::default(),
-            true,
-            lsb,
-        )
+        open_uart(board, true, lsb)
     }
 
     /// A real board on serial port `port` at `baud` (its UART's rate).
@@ -295,14 +307,7 @@ impl Board {
     #[staticmethod]
     #[pyo3(signature = (*, lsb=DEFAULT_FORMAT.position_lsb))]
     fn axi_model(lsb: f64) -> PyResult<Board> {
-        let board = AxiBoard::model(&design(115_200)?);
-        let t = axi_transport(board).map_err(|e| BoardError::new_err(e.to_string()))?;
-        open(
-            Medium::Axi(Box::new(t)),
-            RunOptions::memory_mapped(),
-            false,
-            lsb,
-        )
+        open_axi(AxiBoard::model(&design(115_200)?), false, lsb)
     }
 
     /// The Verilated AXI4-Lite top with its model in lockstep (every output of every clock
@@ -314,13 +319,7 @@ impl Board {
         let board = AxiBoard::lockstep(&design(115_200)?).map_err(|e| {
             BoardError::new_err(format!("cannot build the Verilated AXI4-Lite top: {e}"))
         })?;
-        let t = axi_transport(board).map_err(|e| BoardError::new_err(e.to_string()))?;
-        open(
-            Medium::Axi(Box::new(t)),
-            RunOptions::memory_mapped(),
-            true,
-            lsb,
-        )
+        open_axi(board, true, lsb)
     }
 
     /// A real board's station through its UIO device (`/dev/uioN`, on a Zynq running the
