@@ -38,9 +38,10 @@ route() {
   local status=0
   (cd "$dir" && "$nextpnr" --85k --package CABGA381 --speed 6 --freq "$freq" --seed 1 \
     --json timing_top.json >nextpnr.log 2>&1) || status=$?
-  # The routed report's last line: "Max frequency for clock '...': F MHz (PASS|FAIL at T MHz)".
+  # The routed report's last line: "Max frequency for clock '...': F MHz (PASS|FAIL at T MHz)",
+  # after routing completed (the same line after placement is an estimate).
   local last
-  last="$(grep -E "Max frequency for clock" "$dir/nextpnr.log" | tail -1 || true)"
+  last="$(sed -n '/Routing complete/,$p' "$dir/nextpnr.log" | grep -E "Max frequency for clock" | tail -1 || true)"
   if [ "$status" -ne 0 ] || ! grep -q "PASS at" <<<"$last"; then
     tail -5 "$dir/nextpnr.log" >&2
     if grep -q "FAIL at" <<<"$last"; then

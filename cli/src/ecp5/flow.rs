@@ -77,10 +77,16 @@ impl Routed {
     }
 }
 
-/// Reads the routed report from nextpnr's log: the last "Max frequency for clock" line (the
-/// routed one: Fmax, PASS or FAIL, the constraint) and the utilisation, when it is there.
+/// Reads the routed report from nextpnr's log: the "Max frequency for clock" line after routing
+/// completed (Fmax, PASS or FAIL, the constraint) and the utilisation, when it is there. The
+/// same line after placement is an estimate: a log that ends before routing completed (nextpnr
+/// stopped or killed) has no routed report.
 pub fn parse_nextpnr_log(text: &str) -> Option<Routed> {
-    let last = text
+    // router1 ends with "Routing complete.", router2 with its time.
+    let routed_from = text
+        .rfind("Routing complete")
+        .or_else(|| text.rfind("Router2 time"))?;
+    let last = text[routed_from..]
         .lines()
         .rfind(|l| l.contains("Max frequency for clock"))?;
     // "... 'NAME': 92.01 MHz (PASS at 75.00 MHz)"
@@ -233,6 +239,7 @@ mod tests {
                    Info:     Total LUT4s:     15120/83640    18%\n\
                    Info: \t          TRELLIS_FF:    5818/  83640     6%\n\
                    Info: Max frequency for clock '$glbnet$clk': 60.00 MHz (FAIL at 75.00 MHz)\n\
+                   Info: Routing complete.\n\
                    Info: Max frequency for clock '$glbnet$clk': 88.12 MHz (PASS at 75.00 MHz)\n";
         let r = parse_nextpnr_log(log).unwrap();
         assert_eq!(
@@ -246,12 +253,18 @@ mod tests {
             }
         );
         // A failing report, and one without the utilisation (another nextpnr's log).
-        let failing =
-            "Info: Max frequency for clock '$glbnet$clk': 91.47 MHz (FAIL at 100.00 MHz)\n";
+        let failing = "Info: Router2 time 73.20s\n\
+            Info: Max frequency for clock '$glbnet$clk': 91.47 MHz (FAIL at 100.00 MHz)\n";
         let r = parse_nextpnr_log(failing).unwrap();
         assert_eq!((r.fmax_mhz, r.target_mhz, r.pass), (91.47, 100.0, false));
         assert_eq!((r.luts, r.ffs), (None, None));
         assert!(parse_nextpnr_log("Info: nothing routed\n").is_none());
+        // Placement's estimate, the log ending before routing completed (nextpnr killed): no
+        // routed report, so the build reports nextpnr's failure, not a routed figure.
+        let placed_only =
+            "Info: Max frequency for clock '$glbnet$clk': 59.36 MHz (FAIL at 75.00 MHz)\n\
+            Info: Routing..\n";
+        assert!(parse_nextpnr_log(placed_only).is_none());
     }
 
     /// `route_report` returns a route that does not close (and makes no bitstream), where
@@ -271,7 +284,7 @@ mod tests {
         let yosys = script("fake-yosys", "exit 0");
         let nextpnr = script(
             "fake-nextpnr",
-            "echo \"Info: Max frequency for clock 'clk': 90.12 MHz (FAIL at 125.00 MHz)\" > nextpnr.log\nexit 1",
+            "printf \"Info: Routing complete.\\nInfo: Max frequency for clock 'clk': 90.12 MHz (FAIL at 125.00 MHz)\\n\" > nextpnr.log\nexit 1",
         );
         let ecppack = script("fake-ecppack", "touch ecppack-ran\nexit 0");
         std::env::set_var("SNAPGEN_YOSYS", &yosys);
@@ -298,6 +311,17 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("nextpnr routed for 125.00 MHz"), "{e}");
+        // nextpnr stopped after placement (killed): its failure, not the estimate as routed.
+        let killed = script(
+            "fake-nextpnr-killed",
+            "echo \"Info: Max frequency for clock 'clk': 59.36 MHz (FAIL at 125.00 MHz)\" > nextpnr.log\nexit 143",
+        );
+        std::env::set_var("SNAPGEN_NEXTPNR_ECP5", &killed);
+        let e = run(&steps, &dir, 125_000_000).unwrap_err().to_string();
+        assert!(
+            e.contains("failed") && !e.contains("routed timing does not close"),
+            "{e}"
+        );
         for var in ["SNAPGEN_YOSYS", "SNAPGEN_NEXTPNR_ECP5", "SNAPGEN_ECPPACK"] {
             std::env::remove_var(var);
         }
