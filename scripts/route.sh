@@ -37,7 +37,7 @@ route() {
   # (The WebAssembly build sees only its working directory: relative paths.)
   local status=0
   (cd "$dir" && "$nextpnr" --85k --package CABGA381 --speed 6 --freq "$freq" --seed 1 \
-    --json timing_top.json >nextpnr.log 2>&1) || status=$?
+    --json timing_top.json --sdf routed.sdf >nextpnr.log 2>&1) || status=$?
   # The routed report's last line: "Max frequency for clock '...': F MHz (PASS|FAIL at T MHz)",
   # after routing completed (the same line after placement is an estimate).
   local last
@@ -45,13 +45,29 @@ route() {
   if [ "$status" -ne 0 ] || ! grep -q "PASS at" <<<"$last"; then
     tail -5 "$dir/nextpnr.log" >&2
     if grep -q "FAIL at" <<<"$last"; then
+      # The failing endpoints, by block (scripts/slack.py).
+      python3 scripts/slack.py "$dir/routed.sdf" "$(python3 -c "print(1000 / $freq)")" 0 >&2 || true
       echo "$module ($label): routed timing does not close at $freq MHz on the ECP5-85F" >&2
     else
       echo "nextpnr-ecp5 failed (exit $status) on $module before reporting timing; its log's end is above" >&2
     fi
     exit 1
   fi
-  echo "$module ($label): routed Fmax $(grep -oE "[0-9.]+ MHz \(PASS" <<<"$last" | grep -oE "^[0-9.]+ MHz") on the ECP5-85F (speed 6), target $freq MHz: closes ($((SECONDS - start)) s)"
+  local fmax
+  fmax="$(grep -oE "[0-9.]+ MHz \(PASS" <<<"$last" | grep -oE "^[0-9.]+")"
+  echo "$module ($label): routed Fmax $fmax MHz on the ECP5-85F (speed 6), target $freq MHz: closes ($((SECONDS - start)) s)"
+  # Every endpoint's slack from the routed delays (scripts/slack.py): those within 0.5 ns of
+  # the period, by block. Its worst slack must be nextpnr's (1/Fmax − period), or the
+  # script misreads the SDF.
+  local period report worst
+  period="$(python3 -c "print(1000 / $freq)")"
+  report="$(python3 scripts/slack.py "$dir/routed.sdf" "$period" 0.5)"
+  sed 's/^/    /' <<<"$report"
+  worst="$(grep -oE "worst [-+0-9.]+ ns$" <<<"$report" | grep -oE "[-+0-9.]+")"
+  python3 -c "import sys; sys.exit(abs($period - 1000 / $fmax - $worst) > 0.01)" || {
+    echo "scripts/slack.py's worst slack ($worst ns) is not nextpnr's ($fmax MHz at $freq MHz)" >&2
+    exit 1
+  }
 }
 
 # The path steppers instantiate the sequencer, the interpolator and the step/dir generators
