@@ -69,6 +69,8 @@ pub struct Sequencer {
     busy_reg: DFF<Bit>,
     done_reg: DFF<Bit>,
     index_reg: DFF<Bits<INDEX_BITS>>,
+    /// `index + 1`, a register beside the index: the end-of-program compare follows no adder.
+    index_after: DFFWithInit<Bits<INDEX_BITS>>,
     /// `index + 1` (low bits), a register beside the index (meaningful while busy).
     address_reg: DFF<Bits<ADDR_BITS>>,
     left: DFF<Bits<TICK_BITS>>,
@@ -113,6 +115,7 @@ impl Default for Sequencer {
             busy_reg: Default::default(),
             done_reg: Default::default(),
             index_reg: Default::default(),
+            index_after: DFFWithInit::new(1.into()),
             address_reg: Default::default(),
             left: Default::default(),
             snap_reg: Default::default(),
@@ -138,12 +141,13 @@ impl Logic for Sequencer {
             busy_reg,
             done_reg,
             index_reg,
+            index_after,
             address_reg,
             left,
             snap_reg,
             tick_count_reg
         );
-        self.next_index.next = self.index_reg.q.val() + self.index_one.val();
+        self.next_index.next = self.index_after.q.val();
         self.address_after.next = self.address_reg.q.val() + self.address_one.val();
         self.address.next = self.address_reg.q.val();
         self.started.next = false;
@@ -151,6 +155,7 @@ impl Logic for Sequencer {
             self.busy_reg.d.next = false;
             self.done_reg.d.next = false;
             self.index_reg.d.next = self.index_zero.val();
+            self.index_after.d.next = self.index_one.val();
             self.address_reg.d.next = self.address_one.val();
             self.left.d.next = self.ticks_zero.val();
             self.snap_reg.d.next = self.snap_zero.val();
@@ -161,6 +166,7 @@ impl Logic for Sequencer {
         } else if self.start.val() & !self.busy_reg.q.val() {
             self.started.next = true;
             self.index_reg.d.next = self.index_zero.val();
+            self.index_after.d.next = self.index_one.val();
             self.address_reg.d.next = self.address_one.val();
             self.tick_count_reg.d.next = self.ticks_zero.val();
             if self.first_count.val() == self.index_zero.val() {
@@ -178,6 +184,7 @@ impl Logic for Sequencer {
             }
             if self.swap.val() {
                 self.index_reg.d.next = self.index_zero.val();
+                self.index_after.d.next = self.index_one.val();
                 self.address_reg.d.next = self.address_one.val();
                 self.tick_count_reg.d.next = self.ticks_zero.val();
                 if self.first_count.val() == self.index_zero.val() {
@@ -198,6 +205,7 @@ impl Logic for Sequencer {
             } else if self.busy_reg.q.val() {
                 if self.left.q.val() == self.ticks_one.val() {
                     self.index_reg.d.next = self.next_index.val();
+                    self.index_after.d.next = self.next_index.val() + self.index_one.val();
                     self.address_reg.d.next = self.address_after.val();
                     if self.next_index.val() == self.count.val() {
                         self.busy_reg.d.next = false;

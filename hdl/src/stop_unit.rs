@@ -239,13 +239,15 @@ fn rom_case() -> String {
 }
 
 /// Bits of an instruction word in the fabric: the ROM word and [`first_reads`] above it.
-const IR_BITS: u32 = ROM_BITS + 12;
+const IR_BITS: u32 = ROM_BITS + 14;
 
 /// The register file's read addresses on an instruction's first clock (step 0), kept in the
 /// ROM above its word so that no decoding lies between the next instruction and the register
 /// file: `{A_SRC[3:0], ak}` in bits 11..6 and `{B_REG, kr}` in bits 5..0, with the words read
 /// at step 0 by the template's `read_word` and `a_word` (kr = 2 for a right shift, else 0;
-/// ak = kr + 1 one word right, kr − 2 two words left, else kr). 0 for LOOP and HALT.
+/// ak = kr + 1 one word right, kr − 2 two words left, else kr), and where A's word lies at step
+/// 0 (bit 12: below word 0, a two-word left shift's kr < 2; bit 13: above word 2, kr + 1 = 3
+/// one word right). 0 for LOOP and HALT.
 fn first_reads(i: &Instr) -> u128 {
     let Instr::Op(op) = i else {
         return 0;
@@ -261,7 +263,9 @@ fn first_reads(i: &Instr) -> u128 {
         AMod::WordLeft2 => (kr + 2) & 3,
         _ => kr,
     };
-    ((bits("A_SRC") & 0xf) << 2 | ak) << 6 | bits("B_REG") << 2 | kr
+    let below = u128::from(op.a_mod == AMod::WordLeft2 && kr < 2);
+    let above = u128::from(op.a_mod == AMod::WordRight && kr + 1 == 3);
+    (above << 1 | below) << 12 | ((bits("A_SRC") & 0xf) << 2 | ak) << 6 | bits("B_REG") << 2 | kr
 }
 
 /// The law's case analysis on the flags (the second implementation of `micro::Derived`): each
@@ -367,7 +371,7 @@ fn stop_unit_verilog() -> String {
             format!("{{{ext}'d0, {name}{top}}}")
         };
         ext_cases.push_str(&format!(
-            "      5'd{code}: a_ext = (ak == 2'd0) ? {name}[47:0] : (ak == 2'd1) ? {name}[95:48] : {high};\n"
+            "      5'd{code}: a_ext = (ak_q == 2'd0) ? {name}[47:0] : (ak_q == 2'd1) ? {name}[95:48] : {high};\n"
         ));
     }
     let holes = Holes::new()
@@ -386,10 +390,13 @@ fn stop_unit_verilog() -> String {
             ),
         )
         .value("IR_TOP", IR_BITS - 1)
+        .value("RA0_HI", ROM_BITS + 11)
         .value("RA0_LO", ROM_BITS + 6)
+        .value("BELOW0", ROM_BITS + 12)
+        .value("ABOVE0", ROM_BITS + 13)
         .value("RB0_HI", ROM_BITS + 5)
         .value("RB0_LO", ROM_BITS)
-        .value("LOCALS_A", 1 + 2 + 2 + 2 + 3 + 1 + 1 + 48 + 48)
+        .value("LOCALS_A", 1 + 2 + 48 + 48)
         .value("LOCALS_B", 7 + 48 * 3 + 49)
         .block("flag_names", flags)
         .block("rom_cases", rom_case())

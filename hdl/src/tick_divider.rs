@@ -25,7 +25,9 @@ pub struct TickDivider {
     pub hold_next: Signal<In, Bit>,
     /// High for one clock every `divisor + 1` clocks (registered).
     pub tick: Signal<Out, Bit>,
-    counter: DFF<Bits<TICK_BITS>>,
+    /// The count plus one (the count after the next edge when no tick restarts it), kept in
+    /// the register instead of the count: the compare below then follows no adder.
+    count_plus_one: DFFWithInit<Bits<TICK_BITS>>,
     tick_reg: DFF<Bit>,
     count_next: Signal<Local, Bits<TICK_BITS>>,
     zero: Constant<Bits<TICK_BITS>>,
@@ -40,7 +42,7 @@ impl Default for TickDivider {
             divisor: Default::default(),
             hold_next: Default::default(),
             tick: Default::default(),
-            counter: Default::default(),
+            count_plus_one: DFFWithInit::new(1.into()),
             tick_reg: Default::default(),
             count_next: Default::default(),
             zero: Constant::new(0.into()),
@@ -52,14 +54,15 @@ impl Default for TickDivider {
 impl Logic for TickDivider {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, counter, tick_reg);
+        dff_setup!(self, clock, count_plus_one, tick_reg);
         self.tick.next = self.tick_reg.q.val();
         if self.reset.val() | self.tick_reg.q.val() {
             self.count_next.next = self.zero.val();
+            self.count_plus_one.d.next = self.one.val();
         } else {
-            self.count_next.next = self.counter.q.val() + self.one.val();
+            self.count_next.next = self.count_plus_one.q.val();
+            self.count_plus_one.d.next = self.count_plus_one.q.val() + self.one.val();
         }
-        self.counter.d.next = self.count_next.val();
         // `>=` rather than `==`: lowering the divisor mid-count never waits for a wrap.
         self.tick_reg.d.next =
             (self.count_next.val() >= self.divisor.val()) & !self.hold_next.val();

@@ -163,7 +163,6 @@ end
 wire rested = in_at_rest && !was_driven_q;
 // The axis moves: a program plays, a stop runs, or v, a or j is not 0.
 wire moving = in_busy || in_stopping || !rested;
-wire stop_limits_valid = (stop_jerk_q != {D_BITS{1'b0}}) && (stop_jerk_q <= stop_accel_q);
 // With the controller on, POWER 1 wants a following-error limit.
 wire servo_ready = (servo_period_q == {SERVO_PERIOD_BITS{1'b0}})
    || (following_limit_q != {FOLLOWING_LIMIT_BITS{1'b0}});
@@ -191,6 +190,16 @@ always @(posedge clock) begin
    cfg_is_jerk <= cfg_param == P_STOP_JERK;
    cfg_is_accel <= cfg_param == P_STOP_ACCEL;
 end
+// The stop limits as they stand (POWER 1 wants them valid), compared the same way: in halves,
+// then combined into pre_limits_valid below (the registers are stable for a frame's bytes).
+reg limits_hi_lt = 1'b0, limits_hi_eq = 1'b0, limits_lo_le = 1'b0;
+always @(posedge clock) begin
+   limits_hi_lt <= stop_jerk_q[D_BITS-1:HALF] < stop_accel_q[D_BITS-1:HALF];
+   limits_hi_eq <= stop_jerk_q[D_BITS-1:HALF] == stop_accel_q[D_BITS-1:HALF];
+   limits_lo_le <= stop_jerk_q[HALF-1:0] <= stop_accel_q[HALF-1:0];
+end
+// (accel_nonzero is STOP_JERK's test: 0 < STOP_JERK.)
+wire stop_limits_valid = accel_nonzero && (limits_hi_lt || (limits_hi_eq && limits_lo_le));
 wire jerk_pair_valid = jerk_nonzero && (jerk_hi_lt || (jerk_hi_eq && jerk_lo_le));
 wire accel_pair_valid = accel_nonzero && (accel_hi_lt || (accel_hi_eq && accel_lo_le));
 

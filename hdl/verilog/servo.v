@@ -125,6 +125,9 @@ wire u_lo = olim_neg_q[16]
    ? ((u[67] && !u_top_ones) || (u_top_ones && (u[15:0] < olim_neg_q[15:0])))
    : u[67];
 
+// The controller's state: what it carries from sample to sample (the divider, the integrator,
+// the derivative filter, the last error and output) and its schedule, cleared while the
+// amplifier is off.
 always @(posedge clock) begin
    fault_q <= 1'b0;
    overrun_q <= 1'b0;
@@ -136,52 +139,18 @@ always @(posedge clock) begin
       term <= 3'd0;
       digit <= 3'd0;
       fin <= 1'b0;
-      p0 <= 32'd0;
-      p1 <= 32'd0;
-      p2 <= 32'd0;
-      p3 <= 32'd0;
-      e48_q <= 48'd0;
-      vs_q <= 56'd0;
-      as_q <= 64'd0;
       f_q <= 48'd0;
       i_q <= 48'd0;
       eprev_q <= 32'd0;
       primed <= 1'b0;
-      e_q <= 32'd0;
-      delta_q <= 33'd0;
-      dfilt_q <= 48'd0;
-      isum_q <= 49'd0;
-      hold_q <= 1'b0;
       sat_hi <= 1'b0;
       sat_lo <= 1'b0;
-      mag_q <= 64'd0;
-      op_q <= 64'd0;
-      neg_q <= 1'b0;
-      gain_q <= 48'd0;
-      acc_q <= 112'd0;
-      sum_q <= 116'd0;
       duty_q <= 16'd0;
    end else begin
       if (tick && (servo_period != {SERVO_PERIOD_BITS{1'b0}}))
          divider <= (divider == {SERVO_PERIOD_BITS{1'b0}}) ? servo_period - 1'b1 : divider - 1'b1;
       if (due && busy) overrun_q <= 1'b1;
       else if (due) begin
-         e48_q <= e48_now;
-         e_q <= e_sat;
-         vs_q <= velocity;
-         as_q <= accel;
-         kp_q <= kp;
-         ki_q <= ki;
-         kd_q <= kd;
-         kv_q <= kv;
-         ka_q <= ka;
-         ilim_q <= integral_limit;
-         olim_q <= output_limit;
-         flim_q <= following_limit;
-         dfk_q <= d_filter;
-         flim_neg_q <= ~{1'b0, following_limit, 16'd0} + 49'd1;
-         ilim_neg_q <= ~{1'b0, integral_limit} + 49'd1;
-         olim_neg_q <= ~{1'b0, output_limit} + 17'd1;
          busy <= 1'b1;
          step0 <= 1'b1;
       end
@@ -189,49 +158,24 @@ always @(posedge clock) begin
          if (step0) begin
             fault_q <= fault_now;
             if (!start && above_peak) peak_q <= e_abs;
-            sum_q <= 116'd1 << {{HALF}};
-            acc_q <= 112'd0;
-            mag_q <= {32'd0, e_abs};
-            neg_q <= e_q[31];
-            gain_q <= kp_q;
             step0 <= 1'b0;
             term <= 3'd0;
             digit <= 3'd0;
          end else if (!fin) begin
             if (first_term && (digit == 3'd0)) begin
-               delta_q <= primed ? ({e_q[31], e_q} - {eprev_q[31], eprev_q}) : 33'd0;
                eprev_q <= e_q;
                primed <= 1'b1;
-               isum_q <= {i_q[47], i_q} + {{17{e_q[31]}}, e_q};
-               hold_q <= hold;
-               dfilt_q <= d_filt;
             end
             if (first_term && (digit == 3'd1)) begin
                i_q <= i_next;
                f_q <= f_q - dfilt_q;
             end
             if (first_term && (digit == 3'd2)) f_q <= f_q + {{15{delta_q[32]}}, delta_q};
-            if (digit != 3'd{{SUM_CLOCK}}) begin
-               if (digit != 3'd0) acc_q <= acc_next;
-               if (digit == 3'd{{DIGITS}}) op_q <= op;
-               if (digit < 3'd{{DIGITS}}) begin
-                  p0 <= g * mag_q[15:0];
-                  p1 <= g * mag_q[31:16];
-                  p2 <= g * mag_q[47:32];
-                  p3 <= g * mag_q[63:48];
-                  gain_q <= {gain_q[31:0], 16'd0};
-               end
-               digit <= digit + 3'd1;
-            end else begin
-               sum_q <= neg_q ? sum_q - {4'd0, acc_q} : sum_q + {4'd0, acc_q};
-               acc_q <= 112'd0;
+            if (digit != 3'd{{SUM_CLOCK}}) digit <= digit + 3'd1;
+            else begin
                digit <= 3'd0;
-               if (term != 3'd{{LAST_TERM}}) begin
-                  mag_q <= op_mag;
-                  neg_q <= op_q[63];
-                  gain_q <= next_gain;
-                  term <= term + 3'd1;
-               end else fin <= 1'b1;
+               if (term != 3'd{{LAST_TERM}}) term <= term + 3'd1;
+               else fin <= 1'b1;
             end
          end else begin
             sat_hi <= u_hi;
@@ -239,6 +183,63 @@ always @(posedge clock) begin
             duty_q <= u_hi ? olim_q : (u_lo ? olim_neg_q[15:0] : u[15:0]);
             busy <= 1'b0;
             fin <= 1'b0;
+         end
+      end
+   end
+end
+
+// The datapath: no reset, each register written before a sample reads it. The sample's
+// operands and the configuration are taken on every clock the controller is idle (so on a
+// sample's clock, due and not busy, they hold that clock's values) and read only while it
+// computes: their some 350 enables are a register (busy), not the sample's decision.
+always @(posedge clock) begin
+   if (!busy) begin
+      e48_q <= e48_now;
+      e_q <= e_sat;
+      vs_q <= velocity;
+      as_q <= accel;
+      kp_q <= kp;
+      ki_q <= ki;
+      kd_q <= kd;
+      kv_q <= kv;
+      ka_q <= ka;
+      ilim_q <= integral_limit;
+      olim_q <= output_limit;
+      flim_q <= following_limit;
+      dfk_q <= d_filter;
+      flim_neg_q <= ~{1'b0, following_limit, 16'd0} + 49'd1;
+      ilim_neg_q <= ~{1'b0, integral_limit} + 49'd1;
+      olim_neg_q <= ~{1'b0, output_limit} + 17'd1;
+   end else if (step0) begin
+      sum_q <= 116'd1 << {{HALF}};
+      acc_q <= 112'd0;
+      mag_q <= {32'd0, e_abs};
+      neg_q <= e_q[31];
+      gain_q <= kp_q;
+   end else if (!fin) begin
+      if (first_term && (digit == 3'd0)) begin
+         delta_q <= primed ? ({e_q[31], e_q} - {eprev_q[31], eprev_q}) : 33'd0;
+         isum_q <= {i_q[47], i_q} + {{17{e_q[31]}}, e_q};
+         hold_q <= hold;
+         dfilt_q <= d_filt;
+      end
+      if (digit != 3'd{{SUM_CLOCK}}) begin
+         if (digit != 3'd0) acc_q <= acc_next;
+         if (digit == 3'd{{DIGITS}}) op_q <= op;
+         if (digit < 3'd{{DIGITS}}) begin
+            p0 <= g * mag_q[15:0];
+            p1 <= g * mag_q[31:16];
+            p2 <= g * mag_q[47:32];
+            p3 <= g * mag_q[63:48];
+            gain_q <= {gain_q[31:0], 16'd0};
+         end
+      end else begin
+         sum_q <= neg_q ? sum_q - {4'd0, acc_q} : sum_q + {4'd0, acc_q};
+         acc_q <= 112'd0;
+         if (term != 3'd{{LAST_TERM}}) begin
+            mag_q <= op_mag;
+            neg_q <= op_q[63];
+            gain_q <= next_gain;
          end
       end
    end

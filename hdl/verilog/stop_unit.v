@@ -27,6 +27,7 @@ localparam [1:0] C_AND = 2'd2, C_OR = 2'd3;
 reg [2:0] phase = PH_IDLE;
 reg ready_q = 1'b0;                      // phase == PH_READY, registered with it
 reg [6:0] pc = 7'd0;
+reg [6:0] pc2 = 7'd2;                    // pc + 2, kept beside it (the ROM's address below)
 reg [{{IR_TOP}}:0] ir = {{IR_HALT}};              // the instruction at pc (and its first_reads)
 reg [1:0] step = 2'd0;
 reg step_first = 1'b0, step_last = 1'b0;  // step is 1, 3 (registered with it)
@@ -35,8 +36,13 @@ reg step_first = 1'b0, step_last = 1'b0;  // step is 1, 3 (registered with it)
 // between ir and the register file's read.
 reg [5:0] ra_q = 6'd0;
 reg [5:0] rb_q = 6'd0;
+// ... and, with them, where A's word lies (below word 0, above word 2; the word of an external
+// value it reads is ra_q's ak): no decoding between step and A's multiplexer either.
+reg a_below_q = 1'b0, a_above_q = 1'b0;
+wire [1:0] ak_q = ra_q[1:0];
 reg [5:0] loop_count = 6'd0;
 reg [6:0] loop_pc = 7'd0;
+reg [6:0] loop_pc2 = 7'd2;               // loop_pc + 2
 reg [{{IR_TOP}}:0] ir_inc = {{IR_HALT}};          // the instruction at pc + 1
 reg [{{IR_TOP}}:0] ir_loop = {{IR_HALT}};         // the instruction at loop_pc
 reg [{{IR_TOP}}:0] ir_loop_inc = {{IR_HALT}};     // the instruction at loop_pc + 1
@@ -96,10 +102,10 @@ endfunction
 //@ instruction_fields
 // The next instruction is ROM[pc + 1] (`ir_inc`), ROM[loop_pc] (`ir_loop`), ir itself or an
 // entry point's word: each a register or a constant, chosen by the next-pc decision. The one
-// ROM lookup, ROM[pc + 2] from pc, becomes `ir_inc` when pc moves on (and `ir_loop_inc`, with
-// the loop's start): the ROM is behind no decision and before no other logic.
+// ROM lookup, ROM[pc + 2] from pc2 (pc + 2 in a register of its own), becomes `ir_inc` when pc
+// moves on (and `ir_loop_inc`, with the loop's start): the ROM is behind no decision and before
+// no other logic.
 wire [6:0] pc_inc = pc + 7'd1;
-wire [6:0] pc_inc2 = pc + 7'd2;
 
 // The word of a 3-word value an instruction's step reads: kr for B (high word first for a right
 // shift of A) and ak for A (kr, kr + 1 one word right, kr - 2 two words left).
@@ -113,7 +119,7 @@ function automatic [1:0] a_word(input [2:0] a_mod, input [1:0] s);
       a_word = (a_mod == M_WLEFT2) ? k - 2'd2 : (a_mod == M_WRIGHT) ? k + 2'd1 : k;
    end
 endfunction
-wire [{{IR_TOP}}:0] ir_inc2 = rom(pc_inc2);
+wire [{{IR_TOP}}:0] ir_inc2 = rom(pc2);   // ROM[pc + 2]: no adder before the ROM
 // ---- Conditions: flags, the law's case analysis on them (micro::Derived), true -------------
 // (The engine's process writes every selection out: a function's arguments and locals cost a
 // simulator stores on every clock, executed or not.)
@@ -124,31 +130,34 @@ wire running = (phase == PH_PREP) || (phase == PH_RUN);
 always @(posedge clock) begin : engine
    // Read: operand words for word `step` (high word first for a right shift).
    reg shr;
-   reg [1:0] kr, ak, ke;
-   reg [2:0] ak_wide;
-   reg a_below, a_above;
+   reg [1:0] ke;
    reg [47:0] a_ext, a_raw;
    // Add: word step - 1, from the words read.
    reg first, last, shift_out, a_zero, a_wide, f_rest, write;
+   reg [FLAG_COUNT-1:0] flags_set;       // the flags with the written flag's source 1
    reg [47:0] a_op, b_op, result;
    reg [48:0] sum;
    reg [31:0] conds;
    reg [6:0] pc_next;
+   reg [6:0] pc2_next;                   // pc_next + 2
    reg [{{IR_TOP}}:0] ir_next;              // ROM[pc_next]
    reg [{{IR_TOP}}:0] ir_inc_next;          // ROM[pc_next + 1]
    reg next_new;                         // ir_next is an instruction's first clock
    reg fetch;                            // load pc and ir
    reg [1:0] step_next;
+   reg [1:0] kr_next;                    // the word read on the next clock's step
    // The law's case analysis on the flags (micro::Derived), for the step-0 conditions.
 //@ derived_declarations
    // The step-0 conditions: b's, and the shift-in, predicate and flag conditions.
    reg c_b, c_shift, c_p, c_f;
    // Every local has a value on every clock (none is a register); the datapath's are computed
    // only while the engine runs.
-   {shr, kr, ak, ke, ak_wide, a_below, a_above, a_ext, a_raw} = {{LOCALS_A}}'d0;
+   {shr, ke, a_ext, a_raw} = {{LOCALS_A}}'d0;
    {first, last, shift_out, a_zero, a_wide, f_rest, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
    conds = 32'd0;
+   flags_set = {FLAG_COUNT{1'b0}};
    pc_next = pc;
+   pc2_next = pc2;
    ir_next = ir;
    ir_inc_next = ir_inc;
    next_new = 1'b0;
@@ -158,21 +167,16 @@ always @(posedge clock) begin : engine
    {c_b, c_shift, c_p, c_f} = 4'd0;
    if (running) begin
       shr = i_a_mod == M_SHR;
-      kr = read_word(i_a_mod, step);
-      // The word of A read: kr, kr + 1 (one word right) or kr - 2 (two words left); below
-      // word 0 (zero) or above word 2 (the sign fill).
-      ak_wide = (i_a_mod == M_WRIGHT) ? {1'b0, kr} + 3'd1 : {1'b0, kr};
-      a_below = (i_a_mod == M_WLEFT2) && (kr < 2'd2);
-      a_above = ak_wide == 3'd3;
-      ak = a_word(i_a_mod, step);
-      // External values, word ak of their 144-bit extension: the chain's registers
-      // sign-extended, the limits zero-extended.
+      // A's word (registered with the read addresses, `ak_q`, `a_below_q`, `a_above_q`): kr,
+      // kr + 1 (one word right) or kr - 2 (two words left); below word 0 (zero) or above word
+      // 2 (the sign fill). External values, word ak_q of their 144-bit extension: the chain's
+      // registers sign-extended, the limits zero-extended.
       case (i_a_src)
 //@ external_words
-      5'd22: a_ext = (ak == 2'd2) ? 48'hffff_c000_0000 : 48'd0;   // D_FLOOR = -2^126
+      5'd22: a_ext = (ak_q == 2'd2) ? 48'hffff_c000_0000 : 48'd0;   // D_FLOOR = -2^126
       default: a_ext = 48'd0;                                    // 16: zero
       endcase
-      a_raw = a_below ? 48'd0 : a_above ? {48{fill}}
+      a_raw = a_below_q ? 48'd0 : a_above_q ? {48{fill}}
          : (i_a_src[4] ? a_ext : rf[ra_q]);
       first = step_first;
       last = step_last;
@@ -189,20 +193,24 @@ always @(posedge clock) begin : engine
       a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
       f_rest = (src[2] & a_zero) | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
       write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
+      flags_set = flag_write(flags, flag_we, flag_and, flag_or, 1'b1);
       // The next instruction.
       if (i_kind == K_LOOP) begin
          pc_next = pc_inc;
+         pc2_next = pc2 + 7'd1;
          ir_next = ir_inc;
          ir_inc_next = ir_inc2;
          next_new = 1'b1;
       end else if ((i_kind == K_OP) && last) begin
          if (i_end_loop && (loop_count != 6'd1)) begin
             pc_next = loop_pc;
+            pc2_next = loop_pc2;
             ir_next = ir_loop;
             ir_inc_next = ir_loop_inc;
             next_new = 1'b1;
          end else begin
             pc_next = pc_inc;
+            pc2_next = pc2 + 7'd1;
             ir_next = ir_inc;
             ir_inc_next = ir_inc2;
             next_new = 1'b1;
@@ -222,38 +230,17 @@ always @(posedge clock) begin : engine
       case (phase)
       PH_IDLE: if (request) begin
          phase <= PH_PREP;
-         step_next = 2'd0;
          jlim <= jerk_limit;
          alim <= accel_limit;
-         pc_next = PC_PREP;
-         ir_next = rom(PC_PREP);
-         ir_inc_next = rom(PC_PREP + 7'd1);
-         next_new = 1'b1;
-         fetch = 1'b1;
       end
-      PH_ARMED: if (engage) begin
-         phase <= PH_RUN;
-         step_next = 2'd0;
-         pc_next = PC_INIT;
-         ir_next = rom(PC_INIT);
-         ir_inc_next = rom(PC_INIT + 7'd1);
-         next_new = 1'b1;
-         fetch = 1'b1;
-      end
-      PH_READY: if (tick) begin
-         phase <= PH_RUN;
-         step_next = 2'd0;
-         pc_next = PC_DECIDE;
-         ir_next = rom(PC_DECIDE);
-         ir_inc_next = rom(PC_DECIDE + 7'd1);
-         next_new = 1'b1;
-         fetch = 1'b1;
-      end
+      PH_ARMED: if (engage) phase <= PH_RUN;
+      PH_READY: if (tick) phase <= PH_RUN;
       default: if (running) begin
          case (i_kind)
          K_LOOP: begin
             loop_count <= i_count;
             loop_pc <= pc_inc;
+            loop_pc2 <= pc2 + 7'd1;
             ir_loop <= ir_inc;
             ir_loop_inc <= ir_inc2;
          end
@@ -297,10 +284,12 @@ always @(posedge clock) begin : engine
             end
             if (write && last) begin
                flag_pend <= 1'b1;
-               // The source: the result's sign (src[0]), its inverse (src[1]) or the rest.
+               // The source: the result's sign (src[0]), its inverse (src[1]) or the rest
+               // (f_rest, which reads A's zero test: it selects between the flags written
+               // with 1 and with the sign's source, computed without it).
                flag_sign_q <= result[47];
-               flags_if0 <= flag_write(flags, flag_we, flag_and, flag_or, src[1] | f_rest);
-               flags_if1 <= flag_write(flags, flag_we, flag_and, flag_or, src[0] | f_rest);
+               flags_if0 <= f_rest ? flags_set : flag_write(flags, flag_we, flag_and, flag_or, src[1]);
+               flags_if1 <= f_rest ? flags_set : flag_write(flags, flag_we, flag_and, flag_or, src[0]);
             end
             if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
             step_next = last ? 2'd0 : step + 2'd1;
@@ -316,12 +305,46 @@ always @(posedge clock) begin : engine
       end
       endcase
    end
+   // An entry point's first instruction, fetched on the clock the phase leaves IDLE, ARMED or
+   // READY. Not gated by reset or cancel (their paths then end at the phase): what is fetched
+   // while the phase stays IDLE is not run, and the next entry fetches again.
+   case (phase)
+   PH_IDLE: if (request) begin
+      step_next = 2'd0;
+      pc_next = PC_PREP;
+      pc2_next = PC_PREP + 7'd2;
+      ir_next = rom(PC_PREP);
+      ir_inc_next = rom(PC_PREP + 7'd1);
+      next_new = 1'b1;
+      fetch = 1'b1;
+   end
+   PH_ARMED: if (engage) begin
+      step_next = 2'd0;
+      pc_next = PC_INIT;
+      pc2_next = PC_INIT + 7'd2;
+      ir_next = rom(PC_INIT);
+      ir_inc_next = rom(PC_INIT + 7'd1);
+      next_new = 1'b1;
+      fetch = 1'b1;
+   end
+   PH_READY: if (tick) begin
+      step_next = 2'd0;
+      pc_next = PC_DECIDE;
+      pc2_next = PC_DECIDE + 7'd2;
+      ir_next = rom(PC_DECIDE);
+      ir_inc_next = rom(PC_DECIDE + 7'd1);
+      next_new = 1'b1;
+      fetch = 1'b1;
+   end
+   default: ;
+   endcase
    // The phase after this edge is READY (the chain's snap multiplexer reads it from a register).
    ready_q <= !reset && !cancel && (((phase == PH_READY) && !tick)
       || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags[F_REST]));
    // The instruction that comes next, and its address.
    if (fetch) begin
       pc <= pc_next;
+      pc2 <= pc2_next;
       ir <= ir_next;
       ir_inc <= ir_inc_next;
    end
@@ -330,8 +353,14 @@ always @(posedge clock) begin : engine
    step_last <= step_next == 2'd3;
    // The read addresses of the next clock: a new instruction's first (step 0) from its ROM
    // word, else this instruction's at the step after this edge.
-   ra_q <= next_new ? ir_next[{{IR_TOP}}:{{RA0_LO}}] : {i_a_src[3:0], a_word(i_a_mod, step_next)};
+   ra_q <= next_new ? ir_next[{{RA0_HI}}:{{RA0_LO}}] : {i_a_src[3:0], a_word(i_a_mod, step_next)};
    rb_q <= next_new ? ir_next[{{RB0_HI}}:{{RB0_LO}}] : {i_b_reg, read_word(i_a_mod, step_next)};
+   // Where A's word of the next clock lies: a new instruction's from its ROM word (step 0),
+   // else this one's at the step after this edge.
+   kr_next = read_word(i_a_mod, step_next);
+   a_below_q <= next_new ? ir_next[{{BELOW0}}] : (i_a_mod == M_WLEFT2) && (kr_next < 2'd2);
+   a_above_q <= next_new ? ir_next[{{ABOVE0}}]
+      : ((i_a_mod == M_WRIGHT) ? {1'b0, kr_next} + 3'd1 : {1'b0, kr_next}) == 3'd3;
 end
 
 // ---- Heading (for the limit switches) and at rest, registered: the sign of v, else a, else j --
