@@ -50,11 +50,15 @@ snapgen_spec::with_motion_core_ports!(block_with_ports! {
         count1: DFF<Bits<INDEX_BITS>> = Default::default(),
         aborted_reg: DFF<Bit> = Default::default(),
         ticks_reg: DFF<Bits<64>> = Default::default(),
+        /// The low bits of `ticks + 1`, a register beside the time base: the swap timer's lead
+        /// and last-tick compare follow no 64-bit adder.
+        ticks_after: DFFWithInit<Bits<SWAP_BITS>> = DFFWithInit::new(1.into()),
         engage: Signal<Local, Bit> = Default::default(),
         ticks_next: Signal<Local, Bits<64>> = Default::default(),
         count_zero: Constant<Bits<INDEX_BITS>> = Constant::new(0.into()),
         ticks_zero: Constant<Bits<64>> = Constant::new(0.into()),
         ticks_one: Constant<Bits<64>> = Constant::new(1.into()),
+        swap_one: Constant<Bits<SWAP_BITS>> = Constant::new(1.into()),
     }
 });
 
@@ -68,18 +72,26 @@ impl Logic for MotionCore {
     #[hdl_gen]
     fn update(&mut self) {
         clock!(self, clock, divider, memory, sequencer, chain, stop_unit, swap_timer);
-        dff_setup!(self, clock, bank, count0, count1, aborted_reg, ticks_reg);
+        dff_setup!(
+            self,
+            clock,
+            bank,
+            count0,
+            count1,
+            aborted_reg,
+            ticks_reg,
+            ticks_after
+        );
         self.ticks_next.next = self.ticks_reg.q.val() + self.ticks_one.val();
         self.divider.reset.next = self.reset.val();
         self.divider.divisor.next = self.tick_div.val();
         // A due tick waits while the stop unit computes the next tick's snap (the tick is a
         // register: it is told what the unit does after this edge).
         self.divider.hold_next.next = self.stop_unit.computing_next.val();
-        // The stop is taken on the first tick after the unit has prepared it.
-        self.engage.next = self.divider.tick.val()
-            & self.stop_unit.armed.val()
-            & !self.reset.val()
-            & !self.abort_move.val();
+        // The stop is taken on the first tick after the unit has prepared it. (A reset or an
+        // abort on that clock wins where engage is read — the sequencer's and the stop unit's
+        // phases, `aborted` — so neither is in engage's path.)
+        self.engage.next = self.divider.tick.val() & self.stop_unit.armed.val();
         // The swap timer: a stop request or an abort disarms it.
         self.swap_timer.reset.next = self.reset.val();
         self.swap_timer.cancel.next = self.abort_move.val() | self.stop.val();
@@ -87,7 +99,7 @@ impl Logic for MotionCore {
         self.swap_timer.arm.next = self.swap.val();
         self.swap_timer.arm_last.next = self.swap_last.val();
         self.swap_timer.tick.next = self.divider.tick.val();
-        self.swap_timer.ticks_next.next = self.ticks_next.val().get_bits::<SWAP_BITS>(0);
+        self.swap_timer.ticks_next.next = self.ticks_after.q.val();
         self.sequencer.swap.next = self.swap_timer.due.val();
         // The sequencer reads the active bank's next segment and, for a start or a swap,
         // segment 0 of the standby bank (the next program's), both from registers' addresses:
@@ -145,8 +157,10 @@ impl Logic for MotionCore {
         }
         if self.reset.val() {
             self.ticks_reg.d.next = self.ticks_zero.val();
+            self.ticks_after.d.next = self.swap_one.val();
         } else if self.divider.tick.val() {
             self.ticks_reg.d.next = self.ticks_next.val();
+            self.ticks_after.d.next = self.ticks_after.q.val() + self.swap_one.val();
         }
         if self.reset.val() {
             self.bank.d.next = false;

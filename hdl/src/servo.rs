@@ -22,8 +22,10 @@
 //! ```
 //!
 //! Every clock has at most one carry chain (an addition or a compare) after its registers —
-//! the limits' negations are latched with the sample, |x| > L is tested as x > L or x < −L —
-//! so that the I/O top closes routed timing (docs/HDL.md).
+//! the limits' negations are latched with the sample, |x| > L is tested as x > L or x < −L,
+//! and the integrator's clamp decides with I + e, from I, e and L (three operands added
+//! carry-save: I + e + ~L ≥ 0, I + e + L < 0), so that no compare follows the sum — so that the
+//! I/O top closes routed timing (docs/HDL.md).
 //!
 //! Gains are not negative, so a term's sign is its operand's; products are of magnitudes and
 //! exact (112 bits), the sum is exact (116 bits): the result is the model's integer law, to the

@@ -24,7 +24,7 @@ reg [31:0] e_q = 32'd0;              // the sample's e = sat32(e48)
 // Term 0's first clocks update D and the integrator (read from term 1's operand on):
 reg [32:0] delta_q = 33'd0;          // Δ = e − e_prev (0 on the first sample)
 reg [47:0] dfilt_q = 48'd0;          // F >>> k, the filter's leak
-reg [48:0] isum_q = 49'd0;           // I + e
+reg [47:0] isum_q = 48'd0;           // I + e (read when it is within ±L)
 reg hold_q = 1'b0;                   // the integrator holds (the output was clamped its way)
 reg sat_hi = 1'b0, sat_lo = 1'b0;    // the last output was clamped
 reg [63:0] mag_q = 64'd0;            // the term's operand: magnitude, sign
@@ -47,7 +47,7 @@ reg [FOLLOWING_LIMIT_BITS-1:0] flim_q = {FOLLOWING_LIMIT_BITS{1'b0}};
 reg [D_FILTER_BITS-1:0] dfk_q = {D_FILTER_BITS{1'b0}};
 // ... and the limits' negations, latched with them (each compare is then one carry chain).
 reg [48:0] flim_neg_q = 49'd0;       // −(FOLLOWING_LIMIT << {{E_FRAC}})
-reg [48:0] ilim_neg_q = 49'd0;       // −INTEGRAL_LIMIT
+reg [47:0] ilim_neg_q = 48'd0;       // −INTEGRAL_LIMIT
 reg [16:0] olim_neg_q = 17'd0;       // −OUTPUT_LIMIT
 reg [15:0] duty_q = 16'd0;
 reg fault_q = 1'b0, overrun_q = 1'b0;
@@ -77,9 +77,21 @@ wire [31:0] e_abs = e_q[31] ? (~e_q + 32'd1) : e_q;                // 2^31 fits
 // F −= F >>> k; then F += Δ: F + Δ − (F >>> k) in all.
 wire [47:0] d_filt = $signed(f_q) >>> dfk_q;                       // F >>> k
 wire hold = (sat_hi && !e_q[31] && (e_q != 32'd0)) || (sat_lo && e_q[31]);
-wire i_over = !isum_q[48] && (isum_q > {1'b0, ilim_q});
-wire i_under = isum_q[48] && ($signed(isum_q) < $signed(ilim_neg_q));
-wire [47:0] i_next = hold_q ? i_q : (i_over ? ilim_q : (i_under ? ilim_neg_q[47:0] : isum_q[47:0]));
+// The clamp's decisions, taken with I + e (digit clock 0) from I, e and the limit L, so that no
+// compare follows the sum: I + e > L as I + e + ~L >= 0 (~L = −L − 1), I + e < −L as
+// I + e + L < 0; each three operands added carry-save (their bitwise sum and carries, then one
+// carry chain), in 50 bits (|I| < 2^47, |e| < 2^31, 0 <= L < 2^48).
+wire [49:0] iw = {{2{i_q[47]}}, i_q};
+wire [49:0] ew = {{18{e_q[31]}}, e_q};
+wire [49:0] lw = {{(50 - INTEGRAL_LIMIT_BITS){1'b0}}, ilim_q};
+/* verilator lint_off UNUSEDSIGNAL */ // only their signs are read
+wire [49:0] over_t = (iw ^ ew ^ ~lw) + {(iw[48:0] & ew[48:0]) | (iw[48:0] & ~lw[48:0])
+   | (ew[48:0] & ~lw[48:0]), 1'b0};
+wire [49:0] under_t = (iw ^ ew ^ lw) + {(iw[48:0] & ew[48:0]) | (iw[48:0] & lw[48:0])
+   | (ew[48:0] & lw[48:0]), 1'b0};
+/* verilator lint_on UNUSEDSIGNAL */
+reg i_over_q = 1'b0, i_under_q = 1'b0;
+wire [47:0] i_next = hold_q ? i_q : (i_over_q ? ilim_q : (i_under_q ? ilim_neg_q : isum_q));
 wire first_term = (term == 3'd0);
 
 // The next term's operand (sign-extended to 64 bits), registered on the clock before the term
@@ -208,7 +220,7 @@ always @(posedge clock) begin
       flim_q <= following_limit;
       dfk_q <= d_filter;
       flim_neg_q <= ~{1'b0, following_limit, 16'd0} + 49'd1;
-      ilim_neg_q <= ~{1'b0, integral_limit} + 49'd1;
+      ilim_neg_q <= ~integral_limit + 48'd1;
       olim_neg_q <= ~{1'b0, output_limit} + 17'd1;
    end else if (step0) begin
       sum_q <= 116'd1 << {{HALF}};
@@ -219,7 +231,9 @@ always @(posedge clock) begin
    end else if (!fin) begin
       if (first_term && (digit == 3'd0)) begin
          delta_q <= primed ? ({e_q[31], e_q} - {eprev_q[31], eprev_q}) : 33'd0;
-         isum_q <= {i_q[47], i_q} + {{17{e_q[31]}}, e_q};
+         isum_q <= i_q + {{16{e_q[31]}}, e_q};
+         i_over_q <= !over_t[49];
+         i_under_q <= under_t[49];
          hold_q <= hold;
          dfilt_q <= d_filt;
       end

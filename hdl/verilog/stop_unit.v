@@ -64,17 +64,22 @@ reg shift_bit = 1'b0;                    // the bit a shift moves across,
 reg zero_acc = 1'b0;                     // the result is zero so far,
 reg fill = 1'b0;                         // the sign of a one-word right shift's source
 // The flags. An instruction's flag write is applied a clock after its last step (`flag_pend`:
-// the adder's result and the flag's combination are not in one clock's path): on that step
-// the flags are computed both ways, for a result's sign of 0 and of 1 (`flags_if0`,
-// `flags_if1`), and the sign is kept (`flag_sign_q`, the adder's last bit). `flags`, what every
-// reader sees, is the register with the pending write applied: the same value on every clock
-// as if it had been written at once.
+// neither the adder's result nor A's zero and width tests are in one clock's path with the
+// flags' combination): on that step the flags are computed for each source the write can have
+// without reading the operands — the result's sign being 0 (`flags_if0`) or 1 (`flags_if1`),
+// and 1 (`flags_if_rest`) — and the sign (`flag_sign_q`, the adder's last bit) and the rest
+// (`flag_rest_q`: A's zero test, the shift-out, A's width or the condition) are kept. `flags`,
+// what every reader sees, is the register with the pending write applied: the same value on
+// every clock as if it had been written at once.
 reg [FLAG_COUNT-1:0] flags_q = {FLAG_COUNT{1'b0}};
 reg flag_pend = 1'b0;
 reg flag_sign_q = 1'b0;
+reg flag_rest_q = 1'b0;
 reg [FLAG_COUNT-1:0] flags_if0 = {FLAG_COUNT{1'b0}};
 reg [FLAG_COUNT-1:0] flags_if1 = {FLAG_COUNT{1'b0}};
-wire [FLAG_COUNT-1:0] flags = flag_pend ? (flag_sign_q ? flags_if1 : flags_if0) : flags_q;
+reg [FLAG_COUNT-1:0] flags_if_rest = {FLAG_COUNT{1'b0}};
+wire [FLAG_COUNT-1:0] flags = !flag_pend ? flags_q
+   : (flag_rest_q ? flags_if_rest : (flag_sign_q ? flags_if1 : flags_if0));
 
 // The flags after writing flag source `f` into the flag(s) `we`, combined with the old by
 // AND, OR or not at all.
@@ -134,7 +139,6 @@ always @(posedge clock) begin : engine
    reg [47:0] a_ext, a_raw;
    // Add: word step - 1, from the words read.
    reg first, last, shift_out, a_zero, a_wide, f_rest, write;
-   reg [FLAG_COUNT-1:0] flags_set;       // the flags with the written flag's source 1
    reg [47:0] a_op, b_op, result;
    reg [48:0] sum;
    reg [31:0] conds;
@@ -155,7 +159,6 @@ always @(posedge clock) begin : engine
    {shr, ke, a_ext, a_raw} = {{LOCALS_A}}'d0;
    {first, last, shift_out, a_zero, a_wide, f_rest, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
    conds = 32'd0;
-   flags_set = {FLAG_COUNT{1'b0}};
    pc_next = pc;
    pc2_next = pc2;
    ir_next = ir;
@@ -193,7 +196,6 @@ always @(posedge clock) begin : engine
       a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
       f_rest = (src[2] & a_zero) | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
       write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
-      flags_set = flag_write(flags, flag_we, flag_and, flag_or, 1'b1);
       // The next instruction.
       if (i_kind == K_LOOP) begin
          pc_next = pc_inc;
@@ -285,11 +287,13 @@ always @(posedge clock) begin : engine
             if (write && last) begin
                flag_pend <= 1'b1;
                // The source: the result's sign (src[0]), its inverse (src[1]) or the rest
-               // (f_rest, which reads A's zero test: it selects between the flags written
-               // with 1 and with the sign's source, computed without it).
+               // (f_rest: src is one-hot, so the sign's candidates are the flags written with
+               // 0 when the source is the rest).
                flag_sign_q <= result[47];
-               flags_if0 <= f_rest ? flags_set : flag_write(flags, flag_we, flag_and, flag_or, src[1]);
-               flags_if1 <= f_rest ? flags_set : flag_write(flags, flag_we, flag_and, flag_or, src[0]);
+               flag_rest_q <= f_rest;
+               flags_if0 <= flag_write(flags, flag_we, flag_and, flag_or, src[1]);
+               flags_if1 <= flag_write(flags, flag_we, flag_and, flag_or, src[0]);
+               flags_if_rest <= flag_write(flags, flag_we, flag_and, flag_or, 1'b1);
             end
             if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
             step_next = last ? 2'd0 : step + 2'd1;

@@ -1,7 +1,8 @@
 //! The I/O co-simulation's random host: what it sends and does, clock by clock — commands of
 //! every kind with good and bad arguments, bursts past the reply queue, retries, bit errors,
 //! cut frames, noise and line breaks, real moves uploaded and started, stops at random ticks,
-//! switches and the emergency stop, configuration changes — reacting to the device's outputs.
+//! switches and the emergency stop, configuration changes (among them controllers whose
+//! integrator is seen in the duty) — reacting to the device's outputs.
 
 use std::collections::VecDeque;
 
@@ -19,6 +20,7 @@ use snapgen_plan::{plan_from, Method, MoveRequest};
 use snapgen_spec::rules::SWAP_MIN_LEAD;
 
 use super::IoCosimReport;
+use crate::moves::log_uniform;
 
 /// The random host: what it sends and does, clock by clock.
 pub(super) struct Stream {
@@ -46,10 +48,6 @@ pub(super) struct Stream {
     scheduled: Option<(u64, Command)>,
     /// When the emergency stop and the limit switches go back to rest (they are pulses).
     release: [Option<u64>; 3],
-}
-
-fn log_uniform(r: &mut StdRng, lo: f64, hi: f64) -> f64 {
-    r.gen_range(lo.ln()..=hi.ln()).exp()
 }
 
 impl Stream {
@@ -90,8 +88,45 @@ impl Stream {
         self.last_frame = Some(f);
     }
 
+    /// A controller whose integrator is seen in the duty: its clamp reached within a few
+    /// samples (INTEGRAL_LIMIT up to a few counts, in counts · 2^-16), its term worth 0.5 to 200
+    /// PWM clocks at the clamp (Ki · INTEGRAL_LIMIT / 2^48), the output unsaturated
+    /// (proportional up to some 100 clocks a count, no feed-forward); while Disabled, the
+    /// controller turned on with a following limit it does not reach and the amplifier on.
+    fn tuned_controller(&mut self, peer: &mut Peer, disabled: bool) {
+        let r = &mut self.rng;
+        let limit = log_uniform(r, 1e3, 3e5);
+        let ki = (log_uniform(r, 0.5, 200.0) * 2f64.powi(48) / limit).min(Param::Ki.max() as f64);
+        let kp = log_uniform(r, 1e6, 3e10) as i128;
+        let kd = [0, kp][r.gen_range(0..2)];
+        let period = [1, 2, 5][r.gen_range(0..3)];
+        self.send_configs(
+            peer,
+            &[
+                (Param::OutputLimit, 32767),
+                (Param::PwmPeriod, 1000),
+                (Param::Kv, 0),
+                (Param::Ka, 0),
+                (Param::Kd, kd),
+                (Param::Kp, kp),
+                (Param::IntegralLimit, limit as i128),
+                (Param::Ki, ki as i128),
+            ],
+        );
+        if disabled {
+            self.send_configs(
+                peer,
+                &[
+                    (Param::ServoPeriod, period),
+                    (Param::FollowingLimit, 100_000),
+                ],
+            );
+            self.send(peer, Command::Power { on: true });
+        }
+    }
+
     /// A random configuration write, mostly sensible values.
-    fn configure(&mut self, peer: &mut Peer) {
+    fn configure(&mut self, peer: &mut Peer, disabled: bool) {
         let r = &mut self.rng;
         let gain = |r: &mut StdRng| -> i128 {
             match r.gen_range(0..4) {
@@ -100,7 +135,8 @@ impl Stream {
                 _ => log_uniform(r, 1.0, 1.4e14) as i128,
             }
         };
-        let (param, value) = match r.gen_range(0..16) {
+        let (param, value) = match r.gen_range(0..17) {
+            16 => return self.tuned_controller(peer, disabled),
             // The controller: its rate and following limit (Disabled only), gains, limits.
             10 => (Param::ServoPeriod, [0, 1, 1, 2, 5][r.gen_range(0..5)]),
             11 => (
@@ -274,17 +310,22 @@ impl Stream {
                 } else if st.state == AxisState::Disabled as u8 || !st.has(flag::AMPLIFIER) {
                     let s = stop_limits(&mut self.rng);
                     self.send_configs(peer, &[(Param::StopJerk, s.0), (Param::StopAccel, s.1)]);
-                    // Mostly with the controller off again (a stalled-motor test left it on).
-                    if self.rng.gen_bool(0.7) {
-                        self.send(
-                            peer,
-                            Command::Configure {
-                                param: Param::ServoPeriod,
-                                value: 0,
-                            },
-                        );
+                    // Mostly with the controller off again (a stalled-motor test left it on), or
+                    // on with gains whose integrator is seen.
+                    match self.rng.gen_range(0..10) {
+                        0..=5 => {
+                            self.send(
+                                peer,
+                                Command::Configure {
+                                    param: Param::ServoPeriod,
+                                    value: 0,
+                                },
+                            );
+                            self.send(peer, Command::Power { on: true });
+                        }
+                        6..=7 => self.tuned_controller(peer, true),
+                        _ => self.send(peer, Command::Power { on: true }),
                     }
-                    self.send(peer, Command::Power { on: true });
                 } else {
                     self.upload_move(peer, dev);
                 }
@@ -338,7 +379,7 @@ impl Stream {
                 }
             }
             60..=69 => self.damaged(peer),
-            70..=77 => self.configure(peer),
+            70..=77 => self.configure(peer, st.state == AxisState::Disabled as u8),
             78..=80 => {
                 // A line break: the receiver sees a framing error.
                 self.breaking = u64::from(self.design.dividers.uart_divisor) * r.gen_range(10..40);
