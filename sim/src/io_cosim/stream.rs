@@ -91,7 +91,8 @@ impl Stream {
     /// A controller whose integrator is seen in the duty: its clamp reached within a few
     /// samples (INTEGRAL_LIMIT up to a few counts, in counts · 2^-16), its term worth 0.5 to 200
     /// PWM clocks at the clamp (Ki · INTEGRAL_LIMIT / 2^48), the output unsaturated
-    /// (proportional up to some 100 clocks a count, no feed-forward); while Disabled, the
+    /// (proportional and derivative up to some 7 clocks a count: Kp · 2^16 / 2^48, no
+    /// feed-forward); while Disabled, the
     /// controller turned on with a following limit it does not reach and the amplifier on.
     fn tuned_controller(&mut self, peer: &mut Peer, disabled: bool) {
         let r = &mut self.rng;
