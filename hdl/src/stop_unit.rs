@@ -329,7 +329,10 @@ fn stop_unit_verilog() -> String {
     // (TESTABLE_FLAGS + k).
     let decls: Vec<String> = DERIVED_LOGIC.iter().map(|(n, _)| n.to_string()).collect();
     let mut derived_code = String::new();
+    // Read from the flag register itself: an instruction that writes a flag applies the write
+    // on a clock of its own (`micro::FLAG_CLOCKS`), before the next instruction reads them.
     for (n, e) in &DERIVED_LOGIC {
+        let e = e.replace("flags[", "flags_q[");
         derived_code.push_str(&format!("               {n} = {e};\n"));
     }
     let derived: Vec<String> = Derived::ALL
@@ -342,7 +345,7 @@ fn stop_unit_verilog() -> String {
     }
     let pad = COND_TRUE as usize - TESTABLE_FLAGS - DERIVED;
     derived_code.push_str(&format!(
-        "               conds = {{1'b1, {}{}, flags[{}:0]}};\n",
+        "               conds = {{1'b1, {}{}, flags_q[{}:0]}};\n",
         if pad > 0 {
             format!("{pad}'d0, ")
         } else {

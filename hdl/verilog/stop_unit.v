@@ -11,8 +11,12 @@
 
 // ---- The engine (snapgen_model::stop::micro): phases, registers -------------------------------
 // An instruction that computes takes 4 clocks (step 0..3): step s reads operand word s (for
-// s < 3) and adds word s - 1 (for s > 0); step 0 also samples the conditions. LOOP and HALT
-// take one clock. The instruction register holds ROM[pc]; both move as the engine runs.
+// s < 3) and adds word s - 1 (for s > 0); step 0 also samples the conditions, from the flag
+// register. One whose flag write an instruction that may follow it reads at once (its ROM
+// bit LAND) takes a fifth (`land`), on which the write is applied; any other write is applied
+// on the next instruction's step 0, which does not read that flag: the flags an instruction's
+// conditions read are always the register's. LOOP and HALT take one clock. The instruction
+// register holds ROM[pc]; both move as the engine runs.
 localparam [2:0] PH_IDLE = 3'd0, PH_PREP = 3'd1, PH_ARMED = 3'd2, PH_RUN = 3'd3, PH_READY = 3'd4;
 localparam [6:0] PC_PREP = 7'd{{PC_PREP}}, PC_INIT = 7'd{{PC_INIT}}, PC_DECIDE = 7'd{{PC_DECIDE}};
 localparam [31:0] FLAG_COUNT = {{FLAGS}};       // the engine's flags (snapgen_model::stop::micro)
@@ -31,6 +35,7 @@ reg [6:0] pc2 = 7'd2;                    // pc + 2, kept beside it (the ROM's ad
 reg [{{IR_TOP}}:0] ir = {{IR_HALT}};              // the instruction at pc (and its first_reads)
 reg [1:0] step = 2'd0;
 reg step_first = 1'b0, step_last = 1'b0;  // step is 1, 3 (registered with it)
+reg land = 1'b0;                         // the flag write's clock, after step 3
 // The register file's read addresses on this clock ({A_SRC[3:0], ak}, {B_REG, kr} of ir and
 // step), computed on the clock before from the instruction and step it leaves: no decoding
 // between ir and the register file's read.
@@ -69,8 +74,9 @@ reg fill = 1'b0;                         // the sign of a one-word right shift's
 // without reading the operands — the result's sign being 0 (`flags_if0`) or 1 (`flags_if1`),
 // and 1 (`flags_if_rest`) — and the sign (`flag_sign_q`, the adder's last bit) and the rest
 // (`flag_rest_q`: A's zero test, the shift-out, A's width or the condition) are kept. `flags`,
-// what every reader sees, is the register with the pending write applied: the same value on
-// every clock as if it had been written at once.
+// what the unit's output reads, is the register with the pending write applied: the same value
+// on every clock as if it had been written at once. The engine's own readers (the conditions,
+// HALT) read `flags_q`: no write of a flag they read is pending when they read (LAND above).
 reg [FLAG_COUNT-1:0] flags_q = {FLAG_COUNT{1'b0}};
 reg flag_pend = 1'b0;
 reg flag_sign_q = 1'b0;
@@ -139,6 +145,7 @@ always @(posedge clock) begin : engine
    reg [47:0] a_ext, a_raw;
    // Add: word step - 1, from the words read.
    reg first, last, shift_out, a_zero, a_wide, f_rest, write;
+   reg ends;                             // the instruction's last clock: the next is fetched
    reg [47:0] a_op, b_op, result;
    reg [48:0] sum;
    reg [31:0] conds;
@@ -158,6 +165,7 @@ always @(posedge clock) begin : engine
    // only while the engine runs.
    {shr, ke, a_ext, a_raw} = {{LOCALS_A}}'d0;
    {first, last, shift_out, a_zero, a_wide, f_rest, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
+   ends = 1'b0;
    conds = 32'd0;
    pc_next = pc;
    pc2_next = pc2;
@@ -196,6 +204,7 @@ always @(posedge clock) begin : engine
       a_wide = (a_q[47:31] != 17'd0) && (a_q[47:31] != 17'h1ffff);
       f_rest = (src[2] & a_zero) | (src[3] & shift_out) | (src[4] & a_wide) | (src[5] & c_flag);
       write = (i_kind == K_OP) && (step != 2'd0) && c_pred;
+      ends = (last && !i_land) || land;
       // The next instruction.
       if (i_kind == K_LOOP) begin
          pc_next = pc_inc;
@@ -203,7 +212,7 @@ always @(posedge clock) begin : engine
          ir_next = ir_inc;
          ir_inc_next = ir_inc2;
          next_new = 1'b1;
-      end else if ((i_kind == K_OP) && last) begin
+      end else if ((i_kind == K_OP) && ends) begin
          if (i_end_loop && (loop_count != 6'd1)) begin
             pc_next = loop_pc;
             pc2_next = loop_pc2;
@@ -246,7 +255,7 @@ always @(posedge clock) begin : engine
             ir_loop <= ir_inc;
             ir_loop_inc <= ir_inc2;
          end
-         K_OP: begin
+         K_OP: if (!land) begin
             a_q <= a_raw;
             b_q <= rf[rb_q];
             if ((i_a_mod == M_WRIGHT) && !last) fill <= a_raw[47];
@@ -295,13 +304,17 @@ always @(posedge clock) begin : engine
                flags_if1 <= flag_write(flags, flag_we, flag_and, flag_or, src[0]);
                flags_if_rest <= flag_write(flags, flag_we, flag_and, flag_or, 1'b1);
             end
-            if (last && i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
+            if (last && !i_land && i_end_loop && (loop_count != 6'd1))
+               loop_count <= loop_count - 6'd1;
             step_next = last ? 2'd0 : step + 2'd1;
+         end else begin
+            // The flag write's clock: it lands (flags_q <= flags, above); the instruction ends.
+            if (i_end_loop && (loop_count != 6'd1)) loop_count <= loop_count - 6'd1;
          end
          K_HALT: begin
             // Prep done, or a decision made (or the chain found at rest).
             if (phase == PH_PREP) phase <= PH_ARMED;
-            else if (flags[F_REST]) phase <= PH_IDLE;
+            else if (flags_q[F_REST]) phase <= PH_IDLE;
             else phase <= PH_READY;
          end
          default: ;
@@ -344,7 +357,7 @@ always @(posedge clock) begin : engine
    endcase
    // The phase after this edge is READY (the chain's snap multiplexer reads it from a register).
    ready_q <= !reset && !cancel && (((phase == PH_READY) && !tick)
-      || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags[F_REST]));
+      || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags_q[F_REST]));
    // The instruction that comes next, and its address.
    if (fetch) begin
       pc <= pc_next;
@@ -353,6 +366,7 @@ always @(posedge clock) begin : engine
       ir_inc <= ir_inc_next;
    end
    step <= step_next;
+   land <= !reset && !cancel && running && (i_kind == K_OP) && last && i_land;
    step_first <= step_next == 2'd1;
    step_last <= step_next == 2'd3;
    // The read addresses of the next clock: a new instruction's first (step 0) from its ROM

@@ -171,6 +171,7 @@ impl I {
             flag: None,
             to_snap: false,
             end_loop: false,
+            land: false,
         })
     }
     fn a_mod(mut self, m: AMod) -> Self {
@@ -403,6 +404,7 @@ fn build() -> Microprogram {
             .when(Cond::Is(Flag::Zero))),
         Instr::Halt,
     ]);
+    mark_lands(&mut code);
     let p = Microprogram {
         code,
         prep,
@@ -411,6 +413,27 @@ fn build() -> Microprogram {
     };
     check(&p);
     p
+}
+
+/// Marks each instruction whose flag write must land on a clock of its own ([`Op::land`]):
+/// one that may be followed (the next instruction, or the loop's start after a body's last)
+/// by an instruction that reads the flag it writes on its first clock.
+fn mark_lands(code: &mut [Instr]) {
+    let mut loop_start = 0;
+    for pc in 0..code.len() {
+        let next = |k: usize| code.get(k).copied().unwrap_or(Instr::Halt);
+        match code[pc] {
+            Instr::Loop(_) => loop_start = pc + 1,
+            Instr::Op(op) => {
+                if let Some((f, _, _)) = op.flag {
+                    let land = next(pc + 1).reads_first(f)
+                        || (op.end_loop && next(loop_start).reads_first(f));
+                    code[pc] = Instr::Op(Op { land, ..op });
+                }
+            }
+            Instr::Halt => {}
+        }
+    }
 }
 
 /// The program's own consistency: what the engine assumes of it.

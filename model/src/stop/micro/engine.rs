@@ -44,7 +44,8 @@ pub struct Engine {
     pub flags: u32,
     /// Program counter.
     pub pc: usize,
-    /// Clock of the instruction being executed: 0 reads, 1.. add word `step − 1`.
+    /// Clock of the instruction being executed: 0 reads, 1..=[`WORDS`] add word `step − 1`,
+    /// `WORDS + 1` applies its flag write (an instruction whose write [lands](Op::land)).
     pub step: u32,
     loop_count: u32,
     loop_pc: usize,
@@ -136,6 +137,12 @@ impl Engine {
         if self.step == 0 {
             // The read clock (the fabric reads the conditions and the first words).
             self.step = 1;
+            return Step::Running;
+        }
+        if self.step == WORDS + 1 {
+            // The flag's clock (the fabric applies the flag written on the last word's clock;
+            // here it was written at once): the instruction ends.
+            self.next_instruction(&op);
             return Step::Running;
         }
         let word = self.step - 1;
@@ -245,18 +252,23 @@ impl Engine {
             let w = self.a_word(&op, k as i32 + 1, i);
             self.fill = w >> (WORD_BITS - 1) & 1 == 1;
         }
-        if last {
-            self.step = 0;
-            if op.end_loop && self.loop_count > 1 {
-                self.loop_count -= 1;
-                self.pc = self.loop_pc;
-            } else {
-                self.pc += 1;
-            }
+        if last && !op.land {
+            self.next_instruction(&op);
         } else {
             self.step += 1;
         }
         Step::Running
+    }
+
+    /// The instruction after `op`, on its last clock: the loop's start or the next.
+    fn next_instruction(&mut self, op: &Op) {
+        self.step = 0;
+        if op.end_loop && self.loop_count > 1 {
+            self.loop_count -= 1;
+            self.pc = self.loop_pc;
+        } else {
+            self.pc += 1;
+        }
     }
 
     fn pred_holds(&self, op: &Op) -> bool {

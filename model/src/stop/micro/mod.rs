@@ -8,7 +8,10 @@
 //! * Values are 144-bit two's complement, three 48-bit words; an operation adds and writes one
 //!   word a clock (low word first; [`AMod::Shr`] high word first) after a clock that reads its
 //!   conditions and first operands (the fabric reads each word a clock before it adds it), so
-//!   every instruction that computes takes [`OP_CLOCKS`] clocks. `LOOP` and `HALT` take one.
+//!   every instruction that computes takes [`OP_CLOCKS`] clocks, and one more
+//!   ([`FLAG_CLOCKS`]) when it writes a flag an instruction that may follow it reads at once
+//!   ([`Op::land`]): the clock the fabric applies the flag write on, so every instruction's
+//!   conditions are read from the flag register itself. `LOOP` and `HALT` take one.
 //! * 16 registers in a register file (LUT-RAM in the fabric: two read ports, one write port).
 //! * Operand A is a register or an external value (the chain's `v`, `a`, `j` sign-extended, the
 //!   latched stop limits zero-extended, 0, or `D_FLOOR`), optionally shifted: one bit left (a
@@ -36,6 +39,10 @@ pub const WORDS: u32 = 3;
 pub const VALUE_BITS: u32 = WORD_BITS * WORDS;
 /// Clocks of a computing instruction: a read clock, then one per word.
 pub const OP_CLOCKS: u32 = WORDS + 1;
+/// Clocks a computing instruction whose flag write [lands](Op::land) takes beyond
+/// [`OP_CLOCKS`]: the fabric applies the write on a clock of its own (nothing else happens on
+/// it), so no instruction's conditions are read in one clock's path with the write's result.
+pub const FLAG_CLOCKS: u32 = 1;
 /// Registers in the register file.
 pub const REGISTERS: usize = 16;
 /// Bit mask of a word.
@@ -294,6 +301,15 @@ impl Cond {
     pub fn eval(self, f: u32) -> bool {
         eval_code(self.encode(), f)
     }
+
+    /// Whether its value may depend on flag `f` (a derived condition's: on any flag).
+    pub fn reads(self, f: Flag) -> bool {
+        match self {
+            Cond::True | Cond::False => false,
+            Cond::Is(g) | Cond::Not(g) => g == f,
+            Cond::When(_) => true,
+        }
+    }
 }
 
 /// Evaluates an encoded condition (as the Verilog does).
@@ -466,12 +482,17 @@ pub struct Op {
     pub to_snap: bool,
     /// The last instruction of a loop's body.
     pub end_loop: bool,
+    /// Its flag write is applied on a clock of its own ([`FLAG_CLOCKS`]) before the next
+    /// instruction starts: an instruction that may follow it reads that flag at its first clock
+    /// (set by the assembler, [`super::program`]). Otherwise the write lands on the next
+    /// instruction's first clock, which does not read it.
+    pub land: bool,
 }
 
 /// An instruction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Instr {
-    /// Compute ([`OP_CLOCKS`] clocks).
+    /// Compute ([`OP_CLOCKS`] clocks, [`FLAG_CLOCKS`] more when its flag write lands).
     Op(Op),
     /// Repeat the following body `n` times (one clock).
     Loop(u32),
@@ -480,9 +501,35 @@ pub enum Instr {
 }
 
 impl Instr {
+    /// Whether it reads flag `f` on its first clock: an instruction's conditions (its
+    /// predicate, B's condition, the bit a left shift takes in, a flag's test), `HALT` the flag
+    /// `REST`.
+    pub fn reads_first(&self, f: Flag) -> bool {
+        match self {
+            Instr::Op(op) => {
+                let b = match op.b {
+                    BMode::AddSub(_, c) | BMode::AddIf(_, c) => c,
+                    _ => Cond::True,
+                };
+                let shift_in = match op.a_mod {
+                    AMod::Shl(c) => c,
+                    _ => Cond::True,
+                };
+                let test = match op.flag {
+                    Some((_, FlagSrc::Test(c), _)) => c,
+                    _ => Cond::True,
+                };
+                [op.pred, b, shift_in, test].iter().any(|c| c.reads(f))
+            }
+            Instr::Halt => f == Flag::Rest,
+            Instr::Loop(_) => false,
+        }
+    }
+
     /// Clocks it takes.
     pub fn clocks(&self) -> u32 {
         match self {
+            Instr::Op(op) if op.land => OP_CLOCKS + FLAG_CLOCKS,
             Instr::Op(_) => OP_CLOCKS,
             Instr::Loop(_) | Instr::Halt => 1,
         }
@@ -501,8 +548,8 @@ pub struct Field {
 }
 
 /// The ROM word's layout, low bits first (one source for the encoder and the Verilog).
-pub const FIELDS: [Field; 17] = {
-    const NAMES: [(&str, u32); 17] = [
+pub const FIELDS: [Field; 18] = {
+    const NAMES: [(&str, u32); 18] = [
         ("KIND", 2),
         ("DST", 4),
         ("WRITE", 1),
@@ -520,12 +567,13 @@ pub const FIELDS: [Field; 17] = {
         ("TO_SNAP", 1),
         ("END_LOOP", 1),
         ("COUNT", 6),
+        ("LAND", 1),
     ];
     let mut out = [Field {
         name: "",
         lsb: 0,
         bits: 0,
-    }; 17];
+    }; 18];
     let mut lsb = 0;
     let mut k = 0;
     while k < NAMES.len() {
@@ -614,6 +662,7 @@ impl Instr {
                 put(&mut w, "COMBINE", comb);
                 put(&mut w, "TO_SNAP", u32::from(op.to_snap));
                 put(&mut w, "END_LOOP", u32::from(op.end_loop));
+                put(&mut w, "LAND", u32::from(op.land));
             }
         }
         w
