@@ -27,7 +27,7 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::stop::micro::{
-    field, AMod, Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED, FIELDS,
+    field, AMod, ASrc, Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED, FIELDS,
     FLAGS, KIND_HALT, KIND_LOOP, KIND_OP, REGISTERS, ROM_BITS, TESTABLE_FLAGS, WORDS, WORD_BITS,
 };
 use snapgen_model::stop::program::{microprogram, REG_NAMES};
@@ -239,15 +239,59 @@ fn rom_case() -> String {
 }
 
 /// Bits of an instruction word in the fabric: the ROM word and [`first_reads`] above it.
-const IR_BITS: u32 = ROM_BITS + 14;
+const IR_BITS: u32 = ROM_BITS + 12 + A_SEL_BITS;
+
+/// The external values operand A reads, in the order of A's one-hot select (three bits each,
+/// from [`A_SEL_EXT`], one a word): `ASrc`'s code, the core's register, signed (the chain's
+/// registers are sign-extended to the three words, the limits zero-extended).
+fn externals() -> [(u32, &'static str, bool); 5] {
+    [
+        (ASrc::V.encode(), "v", true),
+        (ASrc::A.encode(), "a", true),
+        (ASrc::J.encode(), "j", true),
+        (ASrc::JerkLimit.encode(), "jlim", false),
+        (ASrc::AccelLimit.encode(), "alim", false),
+    ]
+}
+
+/// Operand A's one-hot select: the register file's read.
+const A_SEL_RF: u32 = 0;
+/// ... the sign fill (above word 2).
+const A_SEL_FILL: u32 = 1;
+/// ... word k of external value e ([`externals`]): bit `A_SEL_EXT + 3e + k`.
+const A_SEL_EXT: u32 = 2;
+/// ... `D_FLOOR`'s word 2 (its words 0 and 1 are zero).
+const A_SEL_FLOOR: u32 = A_SEL_EXT + 15;
+/// Bits of the select (none set: zero).
+const A_SEL_BITS: u32 = A_SEL_FLOOR + 1;
+
+/// Operand A's one-hot select for source code `src`, word `ak`, below word 0 or above word 2
+/// (the template's `a_select`, which its generated cases compute on every other step).
+fn a_select(src: u32, ak: u32, below: bool, above: bool) -> u128 {
+    let bit = if below {
+        None
+    } else if above {
+        Some(A_SEL_FILL)
+    } else if src < 16 {
+        Some(A_SEL_RF)
+    } else if src == ASrc::Floor.encode() {
+        (ak == 2).then_some(A_SEL_FLOOR)
+    } else {
+        externals()
+            .iter()
+            .position(|e| e.0 == src)
+            .map(|e| A_SEL_EXT + 3 * e as u32 + ak)
+    };
+    bit.map_or(0, |b| 1 << b)
+}
 
 /// The register file's read addresses on an instruction's first clock (step 0), kept in the
 /// ROM above its word so that no decoding lies between the next instruction and the register
 /// file: `{A_SRC[3:0], ak}` in bits 11..6 and `{B_REG, kr}` in bits 5..0, with the words read
 /// at step 0 by the template's `read_word` and `a_word` (kr = 2 for a right shift, else 0;
-/// ak = kr + 1 one word right, kr − 2 two words left, else kr), and where A's word lies at step
-/// 0 (bit 12: below word 0, a two-word left shift's kr < 2; bit 13: above word 2, kr + 1 = 3
-/// one word right). 0 for LOOP and HALT.
+/// ak = kr + 1 one word right, kr − 2 two words left, else kr), and operand A's one-hot
+/// select at step 0 ([`a_select`], bits 12 and up: below word 0 is a two-word left shift's
+/// kr < 2, above word 2 kr + 1 = 3 one word right). 0 for LOOP and HALT.
 fn first_reads(i: &Instr) -> u128 {
     let Instr::Op(op) = i else {
         return 0;
@@ -263,9 +307,10 @@ fn first_reads(i: &Instr) -> u128 {
         AMod::WordLeft2 => (kr + 2) & 3,
         _ => kr,
     };
-    let below = u128::from(op.a_mod == AMod::WordLeft2 && kr < 2);
-    let above = u128::from(op.a_mod == AMod::WordRight && kr + 1 == 3);
-    (above << 1 | below) << 12 | ((bits("A_SRC") & 0xf) << 2 | ak) << 6 | bits("B_REG") << 2 | kr
+    let below = op.a_mod == AMod::WordLeft2 && kr < 2;
+    let above = op.a_mod == AMod::WordRight && kr + 1 == 3;
+    let sel = a_select(bits("A_SRC") as u32, ak as u32, below, above);
+    sel << 12 | ((bits("A_SRC") & 0xf) << 2 | ak) << 6 | bits("B_REG") << 2 | kr
 }
 
 /// The law's case analysis on the flags (the second implementation of `micro::Derived`): each
@@ -360,23 +405,33 @@ fn stop_unit_verilog() -> String {
     // sign-extended, the limits zero-extended.
     let ext = WORDS * WORD_BITS - D_BITS as u32;
     let top = format!("[D_BITS-1:{}]", 2 * WORD_BITS);
-    let mut ext_cases = String::new();
-    for (code, name, signed) in [
-        (17, "v", true),
-        (18, "a", true),
-        (19, "j", true),
-        (20, "jlim", false),
-        (21, "alim", false),
-    ] {
+    // Operand A: each source's word ANDed with its select bit, ORed.
+    let mut ext_terms = String::new();
+    // The select's cases (the template's a_select) for the steps after the first.
+    let mut ext_selects = String::new();
+    for (e, (code, name, signed)) in externals().into_iter().enumerate() {
         let high = if signed {
             format!("{{{{{ext}{{{name}[D_BITS-1]}}}}, {name}{top}}}")
         } else {
             format!("{{{ext}'d0, {name}{top}}}")
         };
-        ext_cases.push_str(&format!(
-            "      5'd{code}: a_ext = (ak_q == 2'd0) ? {name}[47:0] : (ak_q == 2'd1) ? {name}[95:48] : {high};\n"
+        let b = A_SEL_EXT + 3 * e as u32;
+        ext_terms.push_str(&format!(
+            "         | ({{48{{a_sel_q[{}]}}}} & {name}[47:0]) | ({{48{{a_sel_q[{}]}}}} & {name}[95:48])\n         | ({{48{{a_sel_q[{}]}}}} & {high})\n",
+            b,
+            b + 1,
+            b + 2
+        ));
+        ext_selects.push_str(&format!(
+            "      5'd{code}: a_select[{}:{}] = w;   // {name}\n",
+            b + 2,
+            b
         ));
     }
+    ext_selects.push_str(&format!(
+        "      5'd{}: a_select[{A_SEL_FLOOR}] = w[2];   // D_FLOOR\n",
+        ASrc::Floor.encode()
+    ));
     let holes = Holes::new()
         .value("PC_PREP", p.prep)
         .value("PC_INIT", p.init)
@@ -395,11 +450,16 @@ fn stop_unit_verilog() -> String {
         .value("IR_TOP", IR_BITS - 1)
         .value("RA0_HI", ROM_BITS + 11)
         .value("RA0_LO", ROM_BITS + 6)
-        .value("BELOW0", ROM_BITS + 12)
-        .value("ABOVE0", ROM_BITS + 13)
+        .value("SEL0_LO", ROM_BITS + 12)
+        .value("SEL0_HI", ROM_BITS + 12 + A_SEL_BITS - 1)
+        .value("A_SEL_TOP", A_SEL_BITS - 1)
+        .value("A_SEL_BITS", A_SEL_BITS)
+        .value("A_SEL_RF", A_SEL_RF)
+        .value("A_SEL_FILL", A_SEL_FILL)
+        .value("A_SEL_FLOOR", A_SEL_FLOOR)
         .value("RB0_HI", ROM_BITS + 5)
         .value("RB0_LO", ROM_BITS)
-        .value("LOCALS_A", 1 + 2 + 48 + 48)
+        .value("LOCALS_A", 1 + 2 + 48)
         .value("LOCALS_B", 7 + 48 * 3 + 49)
         .block("flag_names", flags)
         .block("rom_cases", rom_case())
@@ -407,7 +467,8 @@ fn stop_unit_verilog() -> String {
         .block("derived_declarations", derived_decl)
         .block("derived_zeros", derived_zero)
         .block("derived_conditions", derived_code)
-        .block("external_words", ext_cases);
+        .block("external_terms", ext_terms)
+        .block("external_selects", ext_selects);
     let body = fill("stop_unit.v", TEMPLATE, &holes).expect("the stop unit's template is filled");
     let mut params: Vec<LocalParam> = Flag::ALL
         .iter()

@@ -41,10 +41,11 @@ reg land = 1'b0;                         // the flag write's clock, after step 3
 // between ir and the register file's read.
 reg [5:0] ra_q = 6'd0;
 reg [5:0] rb_q = 6'd0;
-// ... and, with them, where A's word lies (below word 0, above word 2; the word of an external
-// value it reads is ra_q's ak): no decoding between step and A's multiplexer either.
-reg a_below_q = 1'b0, a_above_q = 1'b0;
-wire [1:0] ak_q = ra_q[1:0];
+// ... and, with them, operand A's source one-hot (a_select): the register file's read, the
+// sign fill above word 2, word ak of an external value, D_FLOOR's top word, or none (zero, or
+// below word 0): A's multiplexer is an AND-OR of registered selects, with no decoding of the
+// instruction or the step before it.
+reg [{{A_SEL_TOP}}:0] a_sel_q = {{A_SEL_BITS}}'d0;
 reg [5:0] loop_count = 6'd0;
 reg [6:0] loop_pc = 7'd0;
 reg [6:0] loop_pc2 = 7'd2;               // loop_pc + 2
@@ -131,6 +132,22 @@ function automatic [1:0] a_word(input [2:0] a_mod, input [1:0] s);
    end
 endfunction
 wire [{{IR_TOP}}:0] ir_inc2 = rom(pc2);   // ROM[pc + 2]: no adder before the ROM
+// Operand A's one-hot select for A's source `code` and word `ak` (the ROM word carries step 0's).
+function automatic [{{A_SEL_TOP}}:0] a_select(input [4:0] code, input [1:0] ak, input below,
+      input above);
+   reg [2:0] w;                          // ak, one-hot
+   begin
+      w = (ak == 2'd0) ? 3'b001 : (ak == 2'd1) ? 3'b010 : (ak == 2'd2) ? 3'b100 : 3'b000;
+      a_select = {{A_SEL_BITS}}'d0;
+      if (below) ;
+      else if (above) a_select[{{A_SEL_FILL}}] = 1'b1;
+      else if (!code[4]) a_select[{{A_SEL_RF}}] = 1'b1;
+      else case (code)
+//@ external_selects
+      default: ;                         // 16: zero
+      endcase
+   end
+endfunction
 // ---- Conditions: flags, the law's case analysis on them (micro::Derived), true -------------
 // (The engine's process writes every selection out: a function's arguments and locals cost a
 // simulator stores on every clock, executed or not.)
@@ -142,7 +159,7 @@ always @(posedge clock) begin : engine
    // Read: operand words for word `step` (high word first for a right shift).
    reg shr;
    reg [1:0] ke;
-   reg [47:0] a_ext, a_raw;
+   reg [47:0] a_raw;
    // Add: word step - 1, from the words read.
    reg first, last, shift_out, a_zero, a_wide, f_rest, write;
    reg ends;                             // the instruction's last clock: the next is fetched
@@ -163,7 +180,7 @@ always @(posedge clock) begin : engine
    reg c_b, c_shift, c_p, c_f;
    // Every local has a value on every clock (none is a register); the datapath's are computed
    // only while the engine runs.
-   {shr, ke, a_ext, a_raw} = {{LOCALS_A}}'d0;
+   {shr, ke, a_raw} = {{LOCALS_A}}'d0;
    {first, last, shift_out, a_zero, a_wide, f_rest, write, a_op, b_op, result, sum} = {{LOCALS_B}}'d0;
    ends = 1'b0;
    conds = 32'd0;
@@ -178,17 +195,13 @@ always @(posedge clock) begin : engine
    {c_b, c_shift, c_p, c_f} = 4'd0;
    if (running) begin
       shr = i_a_mod == M_SHR;
-      // A's word (registered with the read addresses, `ak_q`, `a_below_q`, `a_above_q`): kr,
-      // kr + 1 (one word right) or kr - 2 (two words left); below word 0 (zero) or above word
-      // 2 (the sign fill). External values, word ak_q of their 144-bit extension: the chain's
-      // registers sign-extended, the limits zero-extended.
-      case (i_a_src)
-//@ external_words
-      5'd22: a_ext = (ak_q == 2'd2) ? 48'hffff_c000_0000 : 48'd0;   // D_FLOOR = -2^126
-      default: a_ext = 48'd0;                                    // 16: zero
-      endcase
-      a_raw = a_below_q ? 48'd0 : a_above_q ? {48{fill}}
-         : (i_a_src[4] ? a_ext : rf[ra_q]);
+      // A's word (its select registered with the read addresses): kr, kr + 1 (one word
+      // right) or kr - 2 (two words left); below word 0 zero, above word 2 the sign fill;
+      // external values, word ak of their 144-bit extension: the chain's registers
+      // sign-extended, the limits zero-extended.
+      a_raw = ({48{a_sel_q[{{A_SEL_RF}}]}} & rf[ra_q]) | {48{a_sel_q[{{A_SEL_FILL}}] & fill}}
+//@ external_terms
+         | ({48{a_sel_q[{{A_SEL_FLOOR}}]}} & 48'hffff_c000_0000);   // D_FLOOR = -2^126
       first = step_first;
       last = step_last;
       ke = shr ? 2'd3 - step : step - 2'd1;
@@ -373,12 +386,12 @@ always @(posedge clock) begin : engine
    // word, else this instruction's at the step after this edge.
    ra_q <= next_new ? ir_next[{{RA0_HI}}:{{RA0_LO}}] : {i_a_src[3:0], a_word(i_a_mod, step_next)};
    rb_q <= next_new ? ir_next[{{RB0_HI}}:{{RB0_LO}}] : {i_b_reg, read_word(i_a_mod, step_next)};
-   // Where A's word of the next clock lies: a new instruction's from its ROM word (step 0),
-   // else this one's at the step after this edge.
+   // A's select on the next clock: a new instruction's from its ROM word (step 0), else this
+   // one's at the step after this edge.
    kr_next = read_word(i_a_mod, step_next);
-   a_below_q <= next_new ? ir_next[{{BELOW0}}] : (i_a_mod == M_WLEFT2) && (kr_next < 2'd2);
-   a_above_q <= next_new ? ir_next[{{ABOVE0}}]
-      : ((i_a_mod == M_WRIGHT) ? {1'b0, kr_next} + 3'd1 : {1'b0, kr_next}) == 3'd3;
+   a_sel_q <= next_new ? ir_next[{{SEL0_HI}}:{{SEL0_LO}}] : a_select(i_a_src, a_word(i_a_mod, step_next),
+      (i_a_mod == M_WLEFT2) && (kr_next < 2'd2),
+      ((i_a_mod == M_WRIGHT) ? {1'b0, kr_next} + 3'd1 : {1'b0, kr_next}) == 3'd3);
 end
 
 // ---- Heading (for the limit switches) and at rest, registered: the sign of v, else a, else j --
