@@ -30,6 +30,7 @@ localparam [1:0] C_AND = 2'd2, C_OR = 2'd3;
 //@ flag_names
 reg [2:0] phase = PH_IDLE;
 reg ready_q = 1'b0;                      // phase == PH_READY, registered with it
+reg armed_q = 1'b0;                      // phase == PH_ARMED, registered with it
 reg [6:0] pc = 7'd0;
 reg [6:0] pc2 = 7'd2;                    // pc + 2, kept beside it (the ROM's address below)
 reg [{{IR_TOP}}:0] ir = {{IR_HALT}};              // the instruction at pc (and its first_reads)
@@ -369,6 +370,9 @@ always @(posedge clock) begin : engine
    default: ;
    endcase
    // The phase after this edge is READY (the chain's snap multiplexer reads it from a register).
+   // ... and ARMED (the sequencer's snap multiplexer reads it, through `engage`).
+   armed_q <= !reset && !cancel && (((phase == PH_ARMED) && !engage)
+      || ((phase == PH_PREP) && (i_kind == K_HALT)));
    ready_q <= !reset && !cancel && (((phase == PH_READY) && !tick)
       || ((phase == PH_RUN) && (i_kind == K_HALT) && !flags_q[F_REST]));
    // The instruction that comes next, and its address.
@@ -411,7 +415,7 @@ end
 
 always @(*) begin
    active = phase != PH_IDLE;
-   armed = phase == PH_ARMED;
+   armed = armed_q;
    computing = phase == PH_RUN;
    // The phase after this edge is RUN (the tick divider's register is told it).
    computing_next = !reset && !cancel && (((phase == PH_ARMED) && engage)
