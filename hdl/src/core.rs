@@ -46,6 +46,10 @@ snapgen_spec::with_motion_core_ports!(block_with_ports! {
         cell_centre: CellCentre = Default::default(),
         stop_unit: StopUnit = Default::default(),
         bank: DFF<Bit> = Default::default(),
+        /// A copy of `bank` for the memory's read port and segment-0 select (toggled from its
+        /// own value, so synthesis keeps it apart): the 104-bit reads do not share a net with
+        /// the bank control.
+        read_bank: DFF<Bit> = Default::default(),
         count0: DFF<Bits<INDEX_BITS>> = Default::default(),
         count1: DFF<Bits<INDEX_BITS>> = Default::default(),
         aborted_reg: DFF<Bit> = Default::default(),
@@ -76,6 +80,7 @@ impl Logic for MotionCore {
             self,
             clock,
             bank,
+            read_bank,
             count0,
             count1,
             aborted_reg,
@@ -104,9 +109,9 @@ impl Logic for MotionCore {
         // The sequencer reads the active bank's next segment and, for a start or a swap,
         // segment 0 of the standby bank (the next program's), both from registers' addresses:
         // the swap's decision on a tick chooses between them in the sequencer, after the reads.
-        self.memory.read_bank.next = self.bank.q.val();
+        self.memory.read_bank.next = self.read_bank.q.val();
         self.memory.read_address.next = self.sequencer.address.val();
-        self.memory.first_bank.next = !self.bank.q.val();
+        self.memory.first_bank.next = !self.read_bank.q.val();
         self.sequencer.entry_ticks.next = self.memory.read_ticks.val();
         self.sequencer.entry_snap.next = self.memory.read_snap.val();
         self.sequencer.first_ticks.next = self.memory.first_ticks.val();
@@ -161,6 +166,11 @@ impl Logic for MotionCore {
         } else if self.divider.tick.val() {
             self.ticks_reg.d.next = self.ticks_next.val();
             self.ticks_after.d.next = self.ticks_after.q.val() + self.swap_one.val();
+        }
+        if self.reset.val() {
+            self.read_bank.d.next = false;
+        } else if self.sequencer.started.val() | self.swap_timer.due.val() {
+            self.read_bank.d.next = !self.read_bank.q.val();
         }
         if self.reset.val() {
             self.bank.d.next = false;
