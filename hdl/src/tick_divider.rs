@@ -29,7 +29,12 @@ pub struct TickDivider {
     /// the register instead of the count: the compare below then follows no adder.
     count_plus_one: DFFWithInit<Bits<TICK_BITS>>,
     tick_reg: DFF<Bit>,
-    count_next: Signal<Local, Bits<TICK_BITS>>,
+    /// The count after the edge (the count plus one) reaches the divisor.
+    due_count: Signal<Local, Bit>,
+    /// A restarted count (0) reaches it: the divisor is 0.
+    due_zero: Signal<Local, Bit>,
+    /// The one of the two the restart (a reset or a tick) chooses.
+    due: Signal<Local, Bit>,
     zero: Constant<Bits<TICK_BITS>>,
     one: Constant<Bits<TICK_BITS>>,
 }
@@ -44,7 +49,9 @@ impl Default for TickDivider {
             tick: Default::default(),
             count_plus_one: DFFWithInit::new(1.into()),
             tick_reg: Default::default(),
-            count_next: Default::default(),
+            due_count: Default::default(),
+            due_zero: Default::default(),
+            due: Default::default(),
             zero: Constant::new(0.into()),
             one: Constant::new(1.into()),
         }
@@ -56,16 +63,20 @@ impl Logic for TickDivider {
     fn update(&mut self) {
         dff_setup!(self, clock, count_plus_one, tick_reg);
         self.tick.next = self.tick_reg.q.val();
+        // `>=` rather than `==`: lowering the divisor mid-count never waits for a wrap. Both
+        // compares, the count's and a restarted count's (0 >= divisor), side by side; the
+        // restart chooses between them last, so the reset (a net that reaches every block) and
+        // the tick pass one multiplexer, not the 32-bit compare.
+        self.due_count.next = self.count_plus_one.q.val() >= self.divisor.val();
+        self.due_zero.next = self.divisor.val() == self.zero.val();
         if self.reset.val() | self.tick_reg.q.val() {
-            self.count_next.next = self.zero.val();
+            self.due.next = self.due_zero.val();
             self.count_plus_one.d.next = self.one.val();
         } else {
-            self.count_next.next = self.count_plus_one.q.val();
+            self.due.next = self.due_count.val();
             self.count_plus_one.d.next = self.count_plus_one.q.val() + self.one.val();
         }
-        // `>=` rather than `==`: lowering the divisor mid-count never waits for a wrap.
-        self.tick_reg.d.next =
-            (self.count_next.val() >= self.divisor.val()) & !self.hold_next.val();
+        self.tick_reg.d.next = self.due.val() & !self.hold_next.val();
     }
 }
 
