@@ -686,7 +686,7 @@ mod tests {
         assert_eq!(b.toolchain(), Toolchain::OpenEcp5);
         assert_eq!(
             (b.clock.frequency_hz, b.fabric_clock_hz()),
-            (25_000_000, 75_000_000)
+            (25_000_000, 100_000_000)
         );
         let ulx3s = BUILTIN[1].1;
         let ps = &BUILTIN[0].1[BUILTIN[0].1.find("\n[ps]").unwrap()..];
@@ -709,7 +709,7 @@ mod tests {
                 "give the ECP5's speed grade",
             ),
             (
-                ulx3s.replace("pll_hz = 75000000", "pll_hz = 77777777"),
+                ulx3s.replace("pll_hz = 100000000", "pll_hz = 77777777"),
                 "no ECP5 PLL setting makes exactly 77777777 Hz",
             ),
             (

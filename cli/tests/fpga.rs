@@ -301,12 +301,12 @@ fn build_writes_an_open_ecp5_build() {
     let top = read("snapgen_ulx3s.v");
     for want in [
         ".CLKI_DIV(1)",
-        ".CLKFB_DIV(3)",
-        ".CLKOP_DIV(8)",
+        ".CLKFB_DIV(4)",
+        ".CLKOP_DIV(6)",
         ".clock(clk)",
         "btn_reset | !pll_locked",
         "assign wifi_gpio0 = 1'b1;",
-        "Clock 75 MHz",
+        "Clock 100 MHz",
     ] {
         assert!(top.contains(want), "board top lacks {want}");
     }
