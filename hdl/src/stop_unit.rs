@@ -27,8 +27,9 @@
 
 use rust_hdl::prelude::*;
 use snapgen_model::stop::micro::{
-    field, AMod, ASrc, Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED, FIELDS,
-    FLAGS, KIND_HALT, KIND_LOOP, KIND_OP, REGISTERS, ROM_BITS, TESTABLE_FLAGS, WORDS, WORD_BITS,
+    field, AMod, ASrc, Derived, Engine, EngineInputs, Flag, Instr, Step, COND_TRUE, DERIVED,
+    FIELDS, FLAGS, KIND_HALT, KIND_LOOP, KIND_OP, REGISTERS, ROM_BITS, TESTABLE_FLAGS, WORDS,
+    WORD_BITS,
 };
 use snapgen_model::stop::program::{microprogram, REG_NAMES};
 
