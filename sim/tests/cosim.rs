@@ -32,7 +32,10 @@ fn streams_only(moves: usize, seed: u64) -> CosimConfig {
 /// on every clock, no mismatch.
 #[test]
 fn thousand_random_moves_match_bit_for_bit() {
-    let mut c = quiet(1000, 7);
+    // Stops that begin outside their limits are rare in this stream (0–4 in 240–260 stops,
+    // depending on where the stops fall): seed 9 has some (seed 7 had one before the stop
+    // unit's landing clocks lengthened its preparation, none after).
+    let mut c = quiet(1000, 9);
     // The PLCopen streams have a test of their own.
     c.stream_share = 0.0;
     let r = run(&verilog(), &c).unwrap();
