@@ -100,8 +100,8 @@ pub struct ClockPin {
     pub iostandard: String,
     /// The oscillator's frequency (Hz).
     pub frequency_hz: u64,
-    /// The fabric clock the FPGA's PLL makes from the oscillator (Hz; ECP5 boards). Without
-    /// it the fabric runs at the oscillator's frequency.
+    /// The fabric clock the FPGA makes from the oscillator (Hz): the ECP5's PLL or a 7-series
+    /// MMCM. Without it the fabric runs at the oscillator's frequency.
     #[serde(default)]
     pub pll_hz: Option<u64>,
 }
@@ -379,13 +379,6 @@ impl Board {
                         "give the device's DSP48E1 and 36 kb block RAM counts (snapgen synth prints the share of each)",
                     ));
                 }
-                if self.clock.pll_hz.is_some() {
-                    return Err(bad(
-                        "clock.pll_hz",
-                        &self.clock.pll_hz.unwrap_or_default(),
-                        "a PLL is generated for ECP5 boards only: remove pll_hz (the fabric runs at frequency_hz), or give the clock you feed the board",
-                    ));
-                }
             }
         }
         if self.input_polarity > 7 {
@@ -419,8 +412,20 @@ impl Board {
             ));
         }
         if let Some(pll) = c.pll_hz {
-            if let Err(e) = crate::ecp5::solve_pll(c.frequency_hz, pll) {
-                return Err(bad("clock.pll_hz", &pll, &e.to_string()));
+            let made = match self.toolchain() {
+                Toolchain::OpenEcp5 => crate::ecp5::solve_pll(c.frequency_hz, pll)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string()),
+                Toolchain::Vivado if self.family != FAMILIES[0] => Err(format!(
+                    "snapgen generates the clock's MMCM for 7-series boards (family \"{}\") only: remove pll_hz (the fabric runs at frequency_hz), or give the clock you feed the board",
+                    FAMILIES[0]
+                )),
+                Toolchain::Vivado => crate::xc7::solve_mmcm(c.frequency_hz, pll)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string()),
+            };
+            if let Err(e) = made {
+                return Err(bad("clock.pll_hz", &pll, &e));
             }
         }
         if let Some(ps) = &self.ps {
@@ -681,7 +686,7 @@ mod tests {
     }
 
     #[test]
-    fn ecp5_boards_are_checked_too() {
+    fn ecp5_boards_and_clock_generators_are_checked_too() {
         let b = builtin("ulx3s").unwrap();
         assert_eq!(b.toolchain(), Toolchain::OpenEcp5);
         assert_eq!(
@@ -690,7 +695,7 @@ mod tests {
         );
         let ulx3s = BUILTIN[1].1;
         let ps = &BUILTIN[0].1[BUILTIN[0].1.find("\n[ps]").unwrap()..];
-        let cases: [(String, &str); 7] = [
+        let cases: [(String, &str); 8] = [
             (ulx3s.replace("level = 1", "level = 2"), "give 0 or 1"),
             (
                 format!("{ulx3s}{ps}"),
@@ -713,11 +718,14 @@ mod tests {
                 "no ECP5 PLL setting makes exactly 77777777 Hz",
             ),
             (
-                BUILTIN[0].1.replace(
-                    "frequency_hz = 125000000",
-                    "frequency_hz = 125000000\npll_hz = 100000000",
-                ),
-                "a PLL is generated for ECP5 boards only",
+                BUILTIN[0]
+                    .1
+                    .replace("pll_hz = 100000000", "pll_hz = 99999999"),
+                "no 7-series MMCM setting makes exactly 99999999 Hz",
+            ),
+            (
+                BUILTIN[0].1.replace("family = \"xc7\"", "family = \"xcu\""),
+                "for 7-series boards (family \"xc7\") only",
             ),
         ];
         for (text, want) in cases {

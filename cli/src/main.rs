@@ -15,6 +15,7 @@ mod fpga;
 mod report;
 mod scenario;
 mod svg;
+mod xc7;
 mod yosys;
 mod zynq;
 

@@ -89,21 +89,10 @@ pub fn solve_pll(fin_hz: u64, fout_hz: u64) -> Result<PllSetting, PllError> {
     if let Some((_, s)) = best {
         return Ok(s);
     }
-    reachable.sort_by_key(|f| f.abs_diff(fout_hz));
-    reachable.dedup();
     Err(PllError {
         fin_hz,
         fout_hz,
-        nearest: if reachable.is_empty() {
-            "it can make no clock from this oscillator".to_string()
-        } else {
-            let near: Vec<String> = reachable
-                .iter()
-                .take(2)
-                .map(|f| format!("{f} Hz"))
-                .collect();
-            format!("nearest: {}", near.join(", "))
-        },
+        nearest: crate::fpga::nearest_clocks(reachable, fout_hz),
     })
 }
 
