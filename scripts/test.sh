@@ -9,8 +9,13 @@
 #
 #   ./scripts/test.sh            # everything
 #   PROPTEST_CASES=20000 ./scripts/test.sh   # more random cases
+#   PROPTEST_RNG_SEED=7 ./scripts/test.sh      # other random cases (default seed 1: the
+#                                              # property tests draw the same cases every run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Deterministic property tests: the same cases on every run unless a seed is given (a random
+# seed once failed CI on a case no change had touched: tests/tests/online.rs, issue 25).
+export PROPTEST_RNG_SEED="${PROPTEST_RNG_SEED:-1}"
 
 ./scripts/setup.sh
 rustup component list --installed 2>/dev/null | grep -q '^rustfmt' || rustup component add rustfmt clippy >/dev/null 2>&1 || true
