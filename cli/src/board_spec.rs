@@ -412,18 +412,7 @@ impl Board {
             ));
         }
         if let Some(pll) = c.pll_hz {
-            let made = match self.toolchain() {
-                Toolchain::OpenEcp5 => crate::ecp5::solve_pll(c.frequency_hz, pll)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string()),
-                Toolchain::Vivado if self.family != FAMILIES[0] => Err(format!(
-                    "snapgen generates the clock's MMCM for 7-series boards (family \"{}\") only: remove pll_hz (the fabric runs at frequency_hz), or give the clock you feed the board",
-                    FAMILIES[0]
-                )),
-                Toolchain::Vivado => crate::xc7::solve_mmcm(c.frequency_hz, pll)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string()),
-            };
+            let made = crate::fpga::ClockGen::solve(self, pll);
             if let Err(e) = made {
                 return Err(bad("clock.pll_hz", &pll, &e));
             }

@@ -277,27 +277,33 @@ impl ClockGen {
     }
 
     /// The generator that makes `fabric_hz` from `b`'s oscillator: none when they are equal;
-    /// refused, with the nearest clocks it can make, when it cannot make it exactly.
-    pub fn for_board(
-        b: &Board,
-        fabric_hz: u64,
-    ) -> Result<Option<ClockGen>, crate::error::InputError> {
+    /// refused, with the nearest clocks it can make, when it cannot make it exactly. The one
+    /// rule for a board file's `pll_hz` and for `--clock-hz`.
+    pub fn solve(b: &Board, fabric_hz: u64) -> Result<Option<ClockGen>, String> {
         let osc = b.clock.frequency_hz;
         if fabric_hz == osc {
             return Ok(None);
         }
-        let made = match b.toolchain() {
+        match b.toolchain() {
             Toolchain::OpenEcp5 => crate::ecp5::solve_pll(osc, fabric_hz)
-                .map(ClockGen::Ecp5)
+                .map(|s| Some(ClockGen::Ecp5(s)))
                 .map_err(|e| e.to_string()),
             Toolchain::Vivado if b.family != crate::board_spec::FAMILIES[0] => Err(format!(
-                "the fabric would run at the oscillator's {osc} Hz: snapgen generates an MMCM for 7-series boards only; give --clock-hz {osc} (or feed the board that clock)"
+                "snapgen generates the clock's MMCM for 7-series boards (family \"{}\") only: run the fabric at the oscillator's {osc} Hz (no pll_hz, or --clock-hz {osc}), or feed the board the clock you want",
+                crate::board_spec::FAMILIES[0]
             )),
             Toolchain::Vivado => crate::xc7::solve_mmcm(osc, fabric_hz)
-                .map(ClockGen::Xc7)
+                .map(|s| Some(ClockGen::Xc7(s)))
                 .map_err(|e| e.to_string()),
-        };
-        made.map(Some).map_err(|e| {
+        }
+    }
+
+    /// [`ClockGen::solve`] for a build, its refusal an input error naming the board.
+    pub fn for_board(
+        b: &Board,
+        fabric_hz: u64,
+    ) -> Result<Option<ClockGen>, crate::error::InputError> {
+        Self::solve(b, fabric_hz).map_err(|e| {
             crate::error::InputError::Board(format!(
                 "{}: the fabric clock of {fabric_hz} Hz: {e}",
                 b.name
