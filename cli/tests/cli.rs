@@ -442,6 +442,55 @@ fn experiment_json_reports_every_profile() {
     }
 }
 
+/// `experiment seed001 --mismatch` (fast loop): the nominal plant first, then the cases given,
+/// two profiles each, with the shaft's error and the trip flag; a bad case is refused (exit 2)
+/// with what to change.
+#[test]
+fn experiment_mismatch_reports_each_case() {
+    let out = snapgen(&[
+        "experiment",
+        "seed001",
+        "--board",
+        "fast",
+        "--json",
+        "--short",
+        "--mismatch",
+        "r=1.4,friction=2",
+    ]);
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON only");
+    let cases = v["cases"].as_array().unwrap();
+    let names: Vec<&str> = cases.iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert_eq!(names, ["nominal", "R +40 %, friction ×2"]);
+    for c in cases {
+        for p in c["profiles"].as_array().unwrap() {
+            assert_eq!(
+                (&p["tripped"], &p["landed_exactly"]),
+                (&false.into(), &true.into()),
+                "{p}"
+            );
+            let e = p["error_at_t_rad"].as_f64().unwrap();
+            let shaft = p["shaft_error_at_t_rad"].as_f64().unwrap();
+            // The encoder reads the shaft to within half a count (2π/8000 rad).
+            assert!(
+                (e - shaft).abs() <= std::f64::consts::PI / 8000.0 + 1e-9,
+                "{p}"
+            );
+            assert!(p["rms_error_rad"].as_f64().unwrap() <= p["peak_error_rad"].as_f64().unwrap());
+        }
+    }
+    let bad = snapgen(&[
+        "experiment",
+        "seed001",
+        "--board",
+        "fast",
+        "--mismatch",
+        "r=-1",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("give a factor from 0.1 to 10"));
+}
+
 /// `gains` prints the CONFIGURE values derived from the plant, and refuses a bad design or a
 /// broken plant file with exit 2 and what to change.
 #[test]

@@ -10,6 +10,10 @@
 //! start at least `LATENCY` clocks later. The device-level loop (`snapgen_sim::closed_loop`,
 //! the device model or the Verilated I/O top, every clock) is the reference; the two agree on
 //! an experiment's figures to a few percent (tested there).
+//!
+//! A sample whose following error is beyond `FOLLOWING_LIMIT` trips the loop as it trips the
+//! fabric (FOLLOWING_ERROR): the amplifier is off from that instant, the reference holds and
+//! nothing drives the motor again ([`FastLoop::tripped`]).
 
 use std::collections::VecDeque;
 
@@ -42,6 +46,11 @@ impl LoopSample {
     /// The tracking error the encoder shows (rad): reference − encoder.
     pub fn error(&self) -> f64 {
         self.reference - self.encoder
+    }
+
+    /// The true shaft's error (rad): reference − shaft angle.
+    pub fn shaft_error(&self) -> f64 {
+        self.reference - self.theta
     }
 }
 
@@ -77,6 +86,7 @@ pub struct FastLoop {
     on: u64,
     negative: bool,
     period_start: u64,
+    tripped: Option<f64>,
 }
 
 impl FastLoop {
@@ -105,6 +115,7 @@ impl FastLoop {
             on: 0,
             negative: false,
             period_start: 0,
+            tripped: None,
         })
     }
 
@@ -126,6 +137,12 @@ impl FastLoop {
         self.next_tick as f64 / self.timing.clock_hz
     }
 
+    /// When a sample's following error passed `FOLLOWING_LIMIT` (s), if it did: the amplifier
+    /// has been off since.
+    pub fn tripped(&self) -> Option<f64> {
+        self.tripped
+    }
+
     /// True while a program plays.
     pub fn playing(&self) -> bool {
         !self.snaps.is_empty()
@@ -141,7 +158,7 @@ impl FastLoop {
         BridgePins {
             pwm: phase < self.on,
             dir: self.negative,
-            enable: true,
+            enable: self.tripped.is_none(),
         }
     }
 
@@ -184,11 +201,22 @@ impl FastLoop {
         if self.cfg.servo_period != 0 {
             if self.divider == 0 {
                 let count = self.plant.count();
-                let s = self
-                    .law
-                    .sample(&self.cfg, self.chain.x, self.chain.v, self.chain.a, count);
-                self.pending
-                    .push_back((self.clock + u64::from(LATENCY), s.duty));
+                let mut s =
+                    self.law
+                        .sample(&self.cfg, self.chain.x, self.chain.v, self.chain.a, count);
+                if s.fault && self.tripped.is_none() {
+                    // FOLLOWING_ERROR: the amplifier off at once, the reference holds.
+                    self.tripped = Some(self.time());
+                    self.snaps.clear();
+                    self.pending.clear();
+                    self.duty_reg = 0;
+                }
+                if self.tripped.is_some() {
+                    s.duty = 0;
+                } else {
+                    self.pending
+                        .push_back((self.clock + u64::from(LATENCY), s.duty));
+                }
                 let st = self.plant.state();
                 sink(&LoopSample {
                     t: self.time(),
@@ -206,7 +234,11 @@ impl FastLoop {
                 self.divider -= 1;
             }
         }
-        // The chain steps with the program's snap.
+        // The chain steps with the program's snap (it holds once tripped: the program is gone
+        // and the chain is at rest or brought there by the snaps already taken).
+        if self.tripped.is_some() {
+            return;
+        }
         let d = match self.snaps.front_mut() {
             Some((left, snap)) => {
                 let d = *snap;

@@ -9,10 +9,12 @@
 //! * [`gains`]: the controller's gains by pole placement on the plant's model.
 //! * [`fast`]: a fast event-driven closed loop around the controller's bit-exact law.
 //! * [`metrics`]: a closed-loop move's figures; [`seed001`]: seed 001's experiment as moves.
+//! * [`mismatch`]: a plant that differs from the one the gains were derived from.
 
 pub mod fast;
 pub mod gains;
 pub mod metrics;
+pub mod mismatch;
 pub mod motor;
 pub mod params;
 pub mod plant;

@@ -1,5 +1,7 @@
 //! The figures of a closed-loop move, from its samples: the error at the end of the reference
-//! move, the peak error, the peak velocity, the peak control effort and the time to settle.
+//! move, the peak and RMS error, the peak velocity, the peak control effort and the time to
+//! settle — the encoder's error (what the controller sees) and the true shaft's beside it
+//! (what the machine does: the encoder hides up to half a count).
 
 use serde::Serialize;
 
@@ -12,6 +14,12 @@ pub struct MoveFigures {
     pub error_at_t_rad: f64,
     /// The largest |reference − encoder| from the move's start to the end of the window (rad).
     pub peak_error_rad: f64,
+    /// The RMS of reference − encoder over the same span (rad).
+    pub rms_error_rad: f64,
+    /// Reference − the shaft's true angle at `T` (rad, signed).
+    pub shaft_error_at_t_rad: f64,
+    /// The largest |reference − the shaft's true angle| over the span (rad).
+    pub shaft_peak_error_rad: f64,
     /// The largest |shaft speed| over the same span (rad/s).
     pub peak_velocity: f64,
     /// The largest |commanded voltage| (duty / PWM period × supply) over the same span (V).
@@ -60,9 +68,13 @@ pub fn figures(
         // Settled on the sample after the last one outside the band.
         Some(t) => inside.iter().find(|s| s.t > t).map(|s| s.t - span.end),
     };
+    let rms = (inside.iter().map(|s| s.error().powi(2)).sum::<f64>() / inside.len() as f64).sqrt();
     Some(MoveFigures {
         error_at_t_rad: at_t.error(),
         peak_error_rad: max(&|s| s.error().abs()),
+        rms_error_rad: rms,
+        shaft_error_at_t_rad: at_t.shaft_error(),
+        shaft_peak_error_rad: max(&|s| s.shaft_error().abs()),
         peak_velocity: max(&|s| s.omega.abs()),
         peak_effort: max(&|s| f64::from(s.duty).abs() * volts_per_duty),
         settle_s,
@@ -88,6 +100,7 @@ mod tests {
                     t,
                     reference: e,
                     encoder: 0.0,
+                    theta: 0.002,
                     omega: if k == 3 { -7.0 } else { 1.0 },
                     duty: if k == 5 { -200 } else { 10 },
                     ..Default::default()
@@ -103,6 +116,17 @@ mod tests {
         assert!((f.error_at_t_rad - 0.1).abs() < 1e-12);
         assert!((f.peak_error_rad - 0.1).abs() < 1e-12);
         assert_eq!((f.peak_velocity, f.peak_effort), (7.0, 20.0));
+        // RMS by hand: ten samples of 0.05, then 0.1, 0.09, …, 0.01 and nine of 0, over the 29
+        // samples in the window (the 30th, at 0.1 × 29 = 2.9000000000000004 s, is past its end).
+        let squares =
+            10.0 * 0.05f64.powi(2) + (1..=10).map(|m| (0.01 * m as f64).powi(2)).sum::<f64>();
+        assert!(
+            (f.rms_error_rad - (squares / 29.0).sqrt()).abs() < 1e-12,
+            "{f:?}"
+        );
+        // The shaft stands 0.002 rad ahead of the encoder's reading.
+        assert!((f.shaft_error_at_t_rad - 0.098).abs() < 1e-12);
+        assert!((f.shaft_peak_error_rad - 0.098).abs() < 1e-12);
         // Out of the band while 0.1 − 0.1(t − 1) > 0.009: t = 1.9 is the last sample out
         // (0.01), so it settles at the next, 2.0 s: 1.0 s after T.
         assert!((f.settle_s.unwrap() - 1.0).abs() < 1e-9, "{f:?}");

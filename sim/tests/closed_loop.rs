@@ -15,6 +15,8 @@ use snapgen_plan::{plan_from, Method, MoveRequest};
 use snapgen_plant::fast::{FabricTiming, FastLoop};
 use snapgen_plant::gains::{derive, LoopDesign, LoopTiming};
 use snapgen_plant::metrics::{figures, MoveSpan};
+use snapgen_plant::mismatch::Mismatch;
+use snapgen_plant::seed001::{profiles, SETTLE_BAND};
 use snapgen_plant::PlantParams;
 use snapgen_sim::closed_loop::{AxisSetup, ClosedLoop};
 use snapgen_sim::io::IoSignal;
@@ -313,4 +315,57 @@ fn a_new_tick_divider_ticks_on_the_same_clock_in_fabric_and_model() {
     let st = l.host().unwrap().status().unwrap();
     assert!(st.has(flag::SERVO_OVERRUN), "{st:?}");
     assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
+}
+
+/// Robust to a wrong model (issue 24): gains derived from the plant file run, on the fabric,
+/// the corner of the sweep a hot winding, a heavier load and doubled friction make (R +40 %,
+/// J +30 %, friction ×2), seed 001's trapezoid: 0 mismatches, no following-error trip, landed
+/// exactly, tracking within 0.015 rad and settled into the seed's band. The same check on the
+/// fast loop across the whole sweep: `plant/tests/robustness.rs`.
+#[test]
+fn the_fabric_loop_survives_a_wrong_model() {
+    let d = design();
+    let (s, f) = setup(&d, true);
+    let m = Mismatch::parse("r=1.4,j=1.3,friction=2").unwrap();
+    let p = m.apply(&PlantParams::default_plant().physical());
+    let prof = profiles(&f, 0.0, 0.3)
+        .unwrap()
+        .into_iter()
+        .find(|p| p.name == "trapezoid")
+        .unwrap();
+    let plan = &prof.moves[0].1;
+    let mut l = ClosedLoop::new(&d, &p, 1e-6, true, 200).unwrap();
+    l.run(200);
+    l.setup(&s).unwrap();
+    l.start(&plan.program).unwrap();
+    let start = *l.starts().last().unwrap();
+    let end = start + plan.ticks_total() as f64 * f.ts;
+    l.run_until(end + 0.3);
+    assert_eq!(l.mismatches(), 0, "{:?}", l.first_mismatch());
+    let mut host = l.host().unwrap();
+    let st = host.status().unwrap();
+    assert_eq!(
+        (st.state, st.error),
+        (AxisState::Standstill as u8, 0),
+        "{st:?}"
+    );
+    let regs = host.state().unwrap();
+    assert_eq!(
+        (regs.x, regs.v, regs.a, regs.j),
+        (plan.final_state.x, 0, 0, 0)
+    );
+    let fig = figures(
+        &l.take_samples(),
+        &MoveSpan {
+            start,
+            end,
+            window_end: end + 0.3,
+        },
+        SETTLE_BAND,
+        p.vs / 100.0,
+    )
+    .unwrap();
+    assert!(fig.peak_error_rad < 0.015, "{fig:?}");
+    assert!(fig.settle_s.is_some_and(|t| t < 0.3), "{fig:?}");
+    assert!(fig.peak_velocity > 30.0, "{fig:?}");
 }

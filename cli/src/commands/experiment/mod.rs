@@ -9,14 +9,20 @@
 //! The loop runs on the Verilated I/O top with the device model in lockstep (`fabric`: every
 //! output compared on every clock; `mismatches` counts the clocks that differ), on the device
 //! model alone (`model`), or on the fast model-only loop (`fast`, `snapgen_plant::fast`).
+//!
+//! With `--mismatch`, the gains come from the plant file and the loop runs plants that differ
+//! from it ([`mismatch`]).
+
+mod mismatch;
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use serde::Serialize;
 
+use snapgen_host::protocol::{AxisState, ErrorId};
 use snapgen_model::device::Design;
-use snapgen_model::io::servo::ServoConfig;
+use snapgen_model::io::servo::{ServoConfig, E_FRAC};
 use snapgen_model::timing::Timing;
 use snapgen_model::{Format, DEFAULT_FORMAT};
 use snapgen_plant::fast::{FabricTiming, FastLoop, LoopSample};
@@ -67,6 +73,13 @@ pub struct Args {
     /// The plant's integration step (µs).
     #[arg(long, default_value_t = 1.0)]
     step_us: f64,
+    /// Robustness to a wrong model: the gains are derived from the plant file (`--motor`), the
+    /// S-curve and the trapezoid run on the fabric-rate loop with plants that differ from it,
+    /// each case factors `r=1.4,j=0.7,friction=2` (resistance, inertia, Coulomb and viscous
+    /// friction; a factor left out is 1), after the nominal plant. Without a case: the standard sweep (nominal, R +40 %,
+    /// J ±30 %, friction ×2 and the two corners).
+    #[arg(long, num_args = 0.., value_name = "CASE")]
+    mismatch: Option<Vec<String>>,
     #[command(flatten)]
     motor: MotorArgs,
     #[command(flatten)]
@@ -98,6 +111,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         step_s: a.step_us * 1e-6,
         out: Some(a.out),
     };
+    if let Some(cases) = &a.mismatch {
+        return mismatch::run(&o, cases, a.json);
+    }
     let r = play(&o)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
@@ -120,6 +136,17 @@ pub enum Board {
     Model,
     /// The fast model-only loop.
     Fast,
+}
+
+impl Board {
+    /// What it is, for a table's heading.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Board::Fabric => "the Verilated I/O top (the device model in lockstep)",
+            Board::Model => "the device model",
+            Board::Fast => "the fast model-only loop",
+        }
+    }
 }
 
 /// The experiment's settings.
@@ -250,30 +277,56 @@ fn format(p: &Physical, ts: f64) -> Format {
     }
 }
 
+/// The design, the format and the PWM period of an experiment's options.
+struct Setup {
+    design: Design,
+    format: Format,
+    pwm_period: u16,
+}
+
+impl Setup {
+    fn of(o: &Options) -> anyhow::Result<Self> {
+        let timing = Timing {
+            clock_hz: o.clock_hz as u64,
+            baud: snapgen_model::timing::DEFAULT_BAUD,
+            ts: o.ts,
+        };
+        let design = snapgen_hdl::verilog::io_design(
+            &Design::from_timing(&DEFAULT_FORMAT, &timing).context("the experiment's timing")?,
+        );
+        let format = format(&o.plant.physical(), design.ts());
+        let pwm_period = (o.clock_hz / o.pwm_hz).round();
+        if !(1.0..=32767.0).contains(&pwm_period) {
+            anyhow::bail!(
+                "--pwm-hz {}: {} clocks per PWM period at {} Hz; give a rate with 1 to 32 767",
+                o.pwm_hz,
+                pwm_period,
+                o.clock_hz
+            );
+        }
+        Ok(Setup {
+            design,
+            format,
+            pwm_period: pwm_period as u16,
+        })
+    }
+}
+
+/// SERVO_PERIOD for a loop at `hz`: whole ticks of `f`.
+fn servo_ticks(f: &Format, hz: f64) -> u16 {
+    ((1.0 / hz) / f.ts).round().clamp(1.0, 65535.0) as u16
+}
+
 /// Runs it.
 pub fn play(o: &Options) -> anyhow::Result<Report> {
     let started = std::time::Instant::now();
     let p = o.plant.physical();
-    let timing = Timing {
-        clock_hz: o.clock_hz as u64,
-        baud: snapgen_model::timing::DEFAULT_BAUD,
-        ts: o.ts,
-    };
-    let design = snapgen_hdl::verilog::io_design(
-        &Design::from_timing(&DEFAULT_FORMAT, &timing).context("the experiment's timing")?,
-    );
-    let f = format(&p, design.ts());
-    let pwm_period = (o.clock_hz / o.pwm_hz).round();
-    if !(1.0..=32767.0).contains(&pwm_period) {
-        anyhow::bail!(
-            "--pwm-hz {}: {} clocks per PWM period at {} Hz; give a rate with 1 to 32 767",
-            o.pwm_hz,
-            pwm_period,
-            o.clock_hz
-        );
-    }
-    let pwm_period = pwm_period as u16;
-    let ticks = |hz: f64| ((1.0 / hz) / f.ts).round().clamp(1.0, 65535.0) as u16;
+    let Setup {
+        design,
+        format: f,
+        pwm_period,
+    } = Setup::of(o)?;
+    let ticks = |hz: f64| servo_ticks(&f, hz);
     let mut loops = vec![("fabric", ticks(o.loop_hz), o.design.feed_forward)];
     if o.host_loop {
         loops.push(("host 5 ms", ticks(200.0), o.design.feed_forward));
@@ -300,34 +353,20 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
             },
         )?);
     }
-    // Every (loop, profile) run is independent: as many at once as there are cores.
+    // Every (loop, profile) run is independent.
     let jobs: Vec<(usize, usize)> = (0..loops.len())
         .flat_map(|l| (0..all.len()).map(move |k| (l, k)))
         .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len());
-    let done = std::sync::Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(l, k)) = jobs.get(i) else { break };
-                let r = run_profile(o, &design, &f, &p, &gains[l].config, pwm_period, &all[k])
-                    .with_context(|| format!("{} on the {} loop", all[k].name, loops[l].0));
-                done.lock().expect("no worker panics").push((l, k, r));
-            });
-        }
+    let done = in_parallel(&jobs, |&(l, k)| {
+        run_profile(o, &design, &f, &p, &gains[l].config, pwm_period, &all[k])
+            .with_context(|| format!("{} on the {} loop", all[k].name, loops[l].0))
     });
-    let mut done = done.into_inner().expect("no worker panics");
-    done.sort_by_key(|(l, k, _)| (*l, *k));
     let mut per_loop: Vec<Vec<ProfileResult>> = vec![Vec::new(); loops.len()];
-    for (l, _, r) in done {
-        let (r, m, c) = r?;
-        mismatches += m;
-        clocks += c;
-        per_loop[l].push(r);
+    for (&(l, _), r) in jobs.iter().zip(done) {
+        let r = r?;
+        mismatches += r.mismatches;
+        clocks += r.clocks;
+        per_loop[l].push(r.result);
     }
     let mut results = Vec::new();
     for ((name, period, ff), (gains, out)) in loops.into_iter().zip(gains.iter().zip(per_loop)) {
@@ -362,7 +401,43 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
     Ok(report)
 }
 
-/// One profile on one loop: its result, the mismatches and the clocks.
+/// `f` of every job, as many at once as there are cores; the results in the jobs' order.
+fn in_parallel<J: Sync, R: Send>(jobs: &[J], f: impl Fn(&J) -> R + Sync) -> Vec<R> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
+    let done = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(job) = jobs.get(i) else { break };
+                let r = f(job);
+                done.lock().expect("no worker panics").push((i, r));
+            });
+        }
+    });
+    let mut done = done.into_inner().expect("no worker panics");
+    done.sort_by_key(|(i, _)| *i);
+    done.into_iter().map(|(_, r)| r).collect()
+}
+
+/// One profile's run on one loop.
+struct Run {
+    result: ProfileResult,
+    /// Clocks the fabric differed from the model.
+    mismatches: u64,
+    /// Clocks simulated.
+    clocks: u64,
+    /// The following error passed its limit: the amplifier went off (FOLLOWING_ERROR).
+    tripped: bool,
+    /// The largest following error at a sample (rad): the board's own record (`fabric`,
+    /// `model`), the samples' (`fast`).
+    following_peak_rad: f64,
+}
+
+/// One profile on one loop.
 fn run_profile(
     o: &Options,
     design: &Design,
@@ -371,11 +446,11 @@ fn run_profile(
     servo: &ServoConfig,
     pwm_period: u16,
     prof: &Profile,
-) -> anyhow::Result<(ProfileResult, u64, u64)> {
+) -> anyhow::Result<Run> {
     let volts_per_duty = p.vs / f64::from(pwm_period);
     let last_end = prof.span.window_end;
     let record_every = (f64::from(design.clock_hz) * 1e-4).round().max(1.0) as u64;
-    let (samples, starts, landed, mismatches, clocks) = match o.board {
+    let (samples, starts, landed, mismatches, clocks, tripped, peak) = match o.board {
         Board::Fast => {
             let timing = FabricTiming {
                 clock_hz: f64::from(design.clock_hz),
@@ -393,7 +468,9 @@ fn run_profile(
             let want = prof.moves.last().map(|(_, p)| p.final_state);
             let landed = want == Some(l.chain());
             let clocks = (last_end * f64::from(design.clock_hz)) as u64;
-            (samples, starts, landed, 0, clocks)
+            let peak = samples.iter().map(|s| s.error().abs()).fold(0.0, f64::max);
+            let tripped = l.tripped().is_some();
+            (samples, starts, landed, 0, clocks, tripped, peak)
         }
         Board::Fabric | Board::Model => {
             let mut l =
@@ -418,10 +495,24 @@ fn run_profile(
             l.run_until(
                 last_start + last_plan.ticks_total() as f64 * f.ts + (last_end - prof.span.end),
             );
-            let s = l.host().map_err(crate::error::failure)?.state()?;
+            let mut host = l.host().map_err(crate::error::failure)?;
+            let s = host.state()?;
+            let st = host.status()?;
+            drop(host);
             let landed = s.x == last_plan.final_state.x && (s.v, s.a, s.j) == (0, 0, 0);
+            let tripped =
+                st.state == AxisState::ErrorStop as u8 && st.error == ErrorId::FollowingError as u8;
+            let peak = f64::from(st.following_peak) / f64::from(1u32 << E_FRAC) * p.rad_per_count();
             let samples = l.take_samples();
-            (samples, starts, landed, l.mismatches(), l.clocks())
+            (
+                samples,
+                starts,
+                landed,
+                l.mismatches(),
+                l.clocks(),
+                tripped,
+                peak,
+            )
         }
     };
     // The reported move's span, from when it really started.
@@ -435,8 +526,8 @@ fn run_profile(
     };
     let figs = figures(&samples, &span, SETTLE_BAND, volts_per_duty)
         .context("no samples in the move's span")?;
-    Ok((
-        ProfileResult {
+    Ok(Run {
+        result: ProfileResult {
             name: prof.name,
             figures: figs,
             paper: prof.paper,
@@ -445,7 +536,9 @@ fn run_profile(
         },
         mismatches,
         clocks,
-    ))
+        tripped,
+        following_peak_rad: peak,
+    })
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -456,11 +549,7 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 pub fn table(r: &Report) -> String {
     let mut s = format!(
         "seed 001's experiment on {}: {}, {} Hz clock, Ts {} s, PWM {:.0} Hz\n",
-        match r.board {
-            Board::Fabric => "the Verilated I/O top (the device model in lockstep)",
-            Board::Model => "the device model",
-            Board::Fast => "the fast model-only loop",
-        },
+        r.board.describe(),
         r.motor,
         r.clock_hz,
         r.ts,
