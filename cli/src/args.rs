@@ -345,6 +345,29 @@ pub struct LinkArgs {
     pub retries: u32,
 }
 
+/// A real board instead of a virtual one (`--port` or `--uio`), and the baud rate: the
+/// port's, or the virtual board's UART where it has one. (`--board` conflicts with both.)
+#[derive(Args, Debug, Clone)]
+pub struct BoardLinkArgs {
+    /// A real board's serial port instead of a virtual board.
+    #[arg(long, conflicts_with = "uio")]
+    pub port: Option<String>,
+    /// A real board's station through its UIO device (`/dev/uioN`, on the board's own
+    /// processor: docs/AXI.md) instead of a virtual board.
+    #[arg(long)]
+    pub uio: Option<PathBuf>,
+    /// Baud rate: the virtual board's UART (its design) or the port's.
+    #[arg(long, default_value_t = 115_200)]
+    pub baud: u32,
+}
+
+impl BoardLinkArgs {
+    /// The real board's medium, or None: a virtual board.
+    pub fn direct(&self) -> Result<Option<DirectLink>, Failure> {
+        direct_link(self.port.as_deref(), self.uio.as_deref(), self.baud)
+    }
+}
+
 /// A session with a board on a serial port or a UIO device.
 pub type BoardSession = Session<FramedLink<Box<dyn Transport>>>;
 

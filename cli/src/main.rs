@@ -106,6 +106,11 @@ enum Command {
     /// plant's model, docs/PLANT.md): in volts and radians, in PWM clocks and counts, and the
     /// integers CONFIGURE writes.
     Gains(gains::Args),
+    /// Identify the motor and its load on a board: a bounded excitation through the fabric's
+    /// loop (following-error limit armed), recorded by TELEMETRY, fitted (speed per volt,
+    /// time constant, Coulomb friction, the dead time's loss); writes a plant file and prints
+    /// the gains for it. On --port/--uio, or the virtual board around --plant/--mismatch.
+    Identify(identify::Args),
     /// The main job on built-in defaults: plan the seed 001 Table 1 and Table 3 moves and a
     /// seed 000 move, print the plans and write their plots; generate the Verilog, co-simulate
     /// the core and the I/O top against the model, synthesise with Yosys; run seed 001's
@@ -136,6 +141,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Format(a) => format::run(a),
         Command::Experiment(a) => experiment::run(a),
         Command::Gains(a) => gains::run(a),
+        Command::Identify(a) => identify::run(a),
         Command::Demo(a) => demo::run(a),
     }
 }

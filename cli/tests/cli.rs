@@ -905,3 +905,26 @@ fn uio_links_refuse_what_is_no_station() {
     let out = snapgen(&send);
     assert_eq!(out.status.code(), Some(1));
 }
+
+/// `identify` refuses bad bounds and cases before anything moves (exit 2), and a virtual
+/// board's motor cannot be given with a real board.
+#[test]
+fn identify_refuses_bad_input() {
+    for (args, says) in [
+        (&["--travel=0"][..], "--travel 0: give a positive number"),
+        (&["--mismatch", "r=0"][..], "give a factor from 0.1 to 10"),
+        (
+            &["--port", "/dev/null", "--mismatch", "r=2"][..],
+            "cannot be used with",
+        ),
+    ] {
+        let mut all = vec!["identify", "--board", "model"];
+        all.extend_from_slice(args);
+        let out = snapgen(&all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(says),
+            "{args:?}"
+        );
+    }
+}

@@ -8,7 +8,8 @@
 //! * [`session`]: a session with a board (PING, its format, typed requests) and the errors a
 //!   host reports.
 //! * [`limits`]: the one rule for the board's controlled-stop limits.
-//! * [`send`]: one move (`snapgen send`) and a stop from the host (`snapgen stop`).
+//! * [`send`]: one move (`snapgen send`) and a stop from the host (`snapgen stop`);
+//!   [`identify`]: an excitation through the board's loop, recorded (`snapgen identify`).
 //! * [`axis`]: the PLCopen host axis (MC_MoveAbsolute with its buffer modes, MC_MoveVelocity,
 //!   MC_Halt, the override), pure; [`driver`] plays it on a board through program swaps;
 //!   [`online`] sets a board up for a script and plays it.
@@ -16,6 +17,7 @@
 pub mod axis;
 pub mod driver;
 pub mod gcode;
+pub mod identify;
 pub mod limits;
 pub mod link;
 pub mod online;

@@ -24,8 +24,13 @@ pub trait Link {
     fn ask(&mut self, c: &Command) -> Result<Reply, LinkError>;
     /// Frames are encoded for a board of this format from now on (after PING).
     fn set_format(&mut self, format: &Format);
-    /// The last TELEMETRY received, once.
+    /// The last TELEMETRY received, once (those before it are dropped).
     fn take_telemetry(&mut self) -> Option<Status>;
+    /// Every TELEMETRY received since the last call, in order (a recording: identification),
+    /// up to [`TELEMETRY_KEPT`] of them. Links that keep only the last give that one.
+    fn drain_telemetry(&mut self) -> Vec<Status> {
+        self.take_telemetry().into_iter().collect()
+    }
     /// The host's clock (s): wall time, or a virtual board's own time.
     fn now(&self) -> f64;
     /// Lets `seconds` pass (receiving meanwhile).
@@ -33,6 +38,10 @@ pub trait Link {
     /// Seconds one byte takes on the wire (0 where there is no wire).
     fn byte_time(&self) -> f64;
 }
+
+/// TELEMETRY frames a link keeps between two reads (the oldest go first): 2^16, over four
+/// minutes of frames every 4 ms.
+pub const TELEMETRY_KEPT: usize = 1 << 16;
 
 /// Why the link failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -143,7 +152,7 @@ pub struct FramedLink<T: Transport> {
     seq: u8,
     format: Format,
     policy: RetryPolicy,
-    telemetry: Option<Status>,
+    telemetry: std::collections::VecDeque<Status>,
     corrupt_segment: Option<u8>,
     buf: Vec<u8>,
 }
@@ -159,7 +168,7 @@ impl<T: Transport> FramedLink<T> {
             seq: first_seq,
             format: snapgen_model::DEFAULT_FORMAT,
             policy,
-            telemetry: None,
+            telemetry: std::collections::VecDeque::new(),
             corrupt_segment: None,
             buf: Vec::new(),
         }
@@ -195,7 +204,12 @@ impl<T: Transport> FramedLink<T> {
         for &b in &self.buf {
             if let Some(Decoded::Frame(f)) = self.decoder.push(b) {
                 match Reply::from_frame(&f) {
-                    Some(Reply::Telemetry(s)) => self.telemetry = Some(s),
+                    Some(Reply::Telemetry(s)) => {
+                        if self.telemetry.len() == TELEMETRY_KEPT {
+                            self.telemetry.pop_front();
+                        }
+                        self.telemetry.push_back(s);
+                    }
                     Some(r) => out.push((f.seq, r)),
                     None => {}
                 }
@@ -261,7 +275,13 @@ impl<T: Transport> Link for FramedLink<T> {
     }
 
     fn take_telemetry(&mut self) -> Option<Status> {
-        self.telemetry.take()
+        let last = self.telemetry.pop_back();
+        self.telemetry.clear();
+        last
+    }
+
+    fn drain_telemetry(&mut self) -> Vec<Status> {
+        self.telemetry.drain(..).collect()
     }
 
     fn now(&self) -> f64 {

@@ -13,6 +13,7 @@
 
 pub mod fast;
 pub mod gains;
+pub mod identify;
 pub mod metrics;
 pub mod mismatch;
 pub mod motor;

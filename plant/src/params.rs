@@ -5,13 +5,13 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// The default plant: maxon RE 40 (148877) with seed 001's load, amplifier and encoder.
 pub const DEFAULT_PLANT: &str = include_str!("../motors/re40-148877.toml");
 
 /// The motor, in its data sheet's units.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Motor {
     /// What it is.
@@ -39,7 +39,7 @@ pub struct Motor {
 }
 
 /// The load on the shaft.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Load {
     /// What it is.
@@ -49,7 +49,7 @@ pub struct Load {
 }
 
 /// The H-bridge: PWM and direction in, the supply across the motor.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Amplifier {
     /// What it is.
@@ -63,7 +63,7 @@ pub struct Amplifier {
 }
 
 /// The quadrature encoder.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Encoder {
     /// Lines (pulses) per revolution: 4 counts each with ×4 decoding.
@@ -73,7 +73,7 @@ pub struct Encoder {
 }
 
 /// A whole plant file.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PlantParams {
     /// The motor.
@@ -183,6 +183,13 @@ impl PlantParams {
         })?;
         p.physical_checked(origin)?;
         Ok(p)
+    }
+
+    /// The plant file's text (TOML, the schema [`PlantParams::parse`] reads), headed by
+    /// `comment` (each line prefixed with `# `).
+    pub fn to_toml(&self, comment: &str) -> String {
+        let head: String = comment.lines().map(|l| format!("# {l}\n")).collect();
+        head + &toml::to_string(self).expect("a plant is plain data")
     }
 
     /// A plant file.
@@ -303,6 +310,14 @@ mod tests {
         let alone = Physical { j: 137e-7, ..p };
         assert!((alone.mechanical_time_constant() * 1e3 - 4.28).abs() < 0.05);
         assert!((p.mechanical_time_constant() * 1e3 - 39.5).abs() < 0.5);
+    }
+
+    #[test]
+    fn a_plant_file_written_reads_back() {
+        let p = PlantParams::default_plant();
+        let text = p.to_toml("identified\nby a test");
+        assert!(text.starts_with("# identified\n# by a test\n"));
+        assert_eq!(PlantParams::parse(&text, "written").unwrap(), p);
     }
 
     #[test]

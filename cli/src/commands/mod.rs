@@ -11,6 +11,7 @@ pub mod demo;
 pub mod experiment;
 pub mod format;
 pub mod gains;
+pub mod identify;
 pub mod online;
 pub mod path;
 pub mod plan;

@@ -42,6 +42,7 @@ use snapgen_sim::axi_board::{axi_link, AxiBoard};
 use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
 
+use crate::args::BoardLinkArgs;
 use crate::error::{failure, InputError};
 use crate::scenario::Scenario;
 
@@ -67,16 +68,8 @@ pub struct Args {
     /// map, docs/AXI.md).
     #[arg(long, value_enum, default_value = "model", conflicts_with_all = ["port", "uio"])]
     board: BoardKind,
-    /// A real board's serial port instead of a virtual board.
-    #[arg(long, conflicts_with = "uio")]
-    port: Option<String>,
-    /// A real board's station through its UIO device (`/dev/uioN`, on the board's own
-    /// processor: docs/AXI.md) instead of a virtual board.
-    #[arg(long)]
-    uio: Option<PathBuf>,
-    /// Baud rate: the virtual board's UART (its design) or the port's.
-    #[arg(long, default_value_t = 115_200)]
-    baud: u32,
+    #[command(flatten)]
+    link: BoardLinkArgs,
     /// Write the per-tick integer trace (tick, x, v, a, j, position LSB).
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -104,9 +97,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let target = Target {
         board: a.board,
-        port: a.port,
-        uio: a.uio,
-        baud: a.baud,
+        port: a.link.port,
+        uio: a.link.uio,
+        baud: a.link.baud,
     };
     let played = play(script, &target)?;
     if a.json {

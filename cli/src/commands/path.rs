@@ -35,6 +35,7 @@ use snapgen_sim::board::VirtualBoard;
 use snapgen_sim::host_link::board_link;
 use snapgen_sim::path_board::{path_core_link, FabricView, PathCoreBoard};
 
+use crate::args::BoardLinkArgs;
 use crate::error::{failure, InputError};
 use crate::scenario::seed002_path;
 
@@ -80,16 +81,8 @@ pub struct Args {
     /// host axis plays its own timeline, each change at the tick it is due.
     #[arg(long, value_enum, conflicts_with_all = ["port", "uio"])]
     board: Option<PathBoard>,
-    /// A real board's serial port instead.
-    #[arg(long, conflicts_with = "uio")]
-    port: Option<String>,
-    /// A real board's station through its UIO device (`/dev/uioN`, on the board's own
-    /// processor: docs/AXI.md) instead.
-    #[arg(long)]
-    uio: Option<PathBuf>,
-    /// Baud rate: the virtual board's UART (its design) or the port's.
-    #[arg(long, default_value_t = 115_200)]
-    baud: u32,
+    #[command(flatten)]
+    link: BoardLinkArgs,
     /// The output grid (mm per LSB).
     #[arg(long, default_value_t = 1e-6)]
     lsb: f64,
@@ -187,7 +180,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             return Err(InputError::Board(format!("{flag} {v}: give a positive number")).into());
         }
     }
-    let on_board = a.board.is_some() || a.port.is_some() || a.uio.is_some();
+    let on_board = a.board.is_some() || a.link.port.is_some() || a.link.uio.is_some();
     if on_board && a.ts.is_some() && a.board != Some(PathBoard::PathCore) {
         return Err(InputError::Board(
             "--ts: a board's tick is read from the board; leave --ts out".into(),
@@ -394,9 +387,7 @@ fn board_run(
     own: Option<PathLimits>,
     events: &[PathEvent],
 ) -> anyhow::Result<(Run, Format, Option<u64>)> {
-    if let Some((t, run)) = crate::args::direct_link(a.port.as_deref(), a.uio.as_deref(), a.baud)
-        .map_err(crate::error::failure)?
-    {
+    if let Some((t, run)) = a.link.direct().map_err(crate::error::failure)? {
         let link = FramedLink::new(t, RetryPolicy::default(), session_seq());
         let (run, format, _) = session_run(
             link,
@@ -410,7 +401,7 @@ fn board_run(
         )?;
         return Ok((run, format, None));
     }
-    let design = crate::commands::online::design(a.baud)?;
+    let design = crate::commands::online::design(a.link.baud)?;
     if a.board == Some(PathBoard::PathCore) {
         let axes_n = axes.len() as u8;
         let format = Format {
@@ -427,7 +418,7 @@ fn board_run(
             (path_speed / a.lsb * format.ts * 2f64.powi(FRAC_BITS as i32)).ceil() as i128;
         let built = snapgen_sim::build::build_path_core(axes_n, false)?;
         let mut board = PathCoreBoard::open(&built.library, axes_n, &format)?;
-        let link = path_core_link(&mut board, &format, f64::from(a.baud));
+        let link = path_core_link(&mut board, &format, f64::from(a.link.baud));
         let (run, format, _) = session_run(
             link,
             RunOptions::default(),
