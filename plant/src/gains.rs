@@ -26,6 +26,11 @@
 //! (`D_FILTER = k`, a low-pass of about `2^k` samples) gets the cutoff nearest to
 //! `d_filter_ratio` times the bandwidth, `f_s / (2π·2^k)`.
 //!
+//! With a current-mode drive (torque mode: docs/PLANT.md) the plant is `K_c / (s (J s + b))`
+//! from the command to the angle and the same placement gives
+//! `Kd = ((2ζ + 1) ω A − B)`, `Kp = (2ζ + 1) ω² A`, `Ki = ω³ A` with `A = J/K_c`, `B = b/K_c`
+//! ([`plant_terms`]; the H-bridge's are the same with `A = τ/K`, `B = 1/K`).
+//!
 //! The volts become PWM clocks (`period / Vs` per volt), radians encoder counts, seconds
 //! samples (Ki, Kd) or ticks (Kv, Ka), and those the fabric's integers
 //! (`snapgen_model::io::servo::ServoConfig::from_physical`).
@@ -34,7 +39,7 @@ use std::f64::consts::PI;
 
 use snapgen_model::io::servo::{GainError, PhysicalGains, ServoConfig, E_FRAC, GAIN_BITS};
 
-use crate::params::Physical;
+use crate::params::{Drive, Physical};
 
 /// What the loop should do.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,6 +139,21 @@ pub enum DesignError {
     Gain(#[from] GainError),
 }
 
+/// The plant's `(A, B)` of `A θ'' + B θ' = u` (u in volts): with the H-bridge `A = J R / Kt`,
+/// `B = (R b + Kt Ke) / Kt` (`τ/K` and `1/K`); with a current-mode drive, whose full command
+/// (`Vs` "volts") is the full-scale current `I`, `A = J Vs / (Kt I)` and `B = b Vs / (Kt I)`
+/// (the back-EMF and the resistance are the drive's to overcome). Coulomb friction is left to
+/// the integrator.
+pub fn plant_terms(p: &Physical) -> (f64, f64) {
+    match p.drive {
+        Drive::Voltage => (p.j * p.r / p.kt, (p.r * p.b + p.kt * p.ke) / p.kt),
+        Drive::Current { .. } => {
+            let per_volt = p.kt * p.i_limit / p.vs;
+            (p.j / per_volt, p.b / per_volt)
+        }
+    }
+}
+
 /// The gains for plant `p` with `design` at `timing`.
 pub fn derive(
     p: &Physical,
@@ -183,17 +203,16 @@ pub fn derive(
     let f = design.bandwidth_hz.min(1.0 / (20.0 * t));
     let w = 2.0 * PI * f;
     let z = design.damping;
-    let (k, tau) = (p.speed_per_volt(), p.mechanical_time_constant());
+    // The plant as `θ'' · A + θ' · B = u`: `A = τ/K` volts per rad/s², `B = 1/K` volts per
+    // rad/s (for a current-mode drive, a volt is a share `1/Vs` of its full-scale command).
+    let (a, b) = plant_terms(p);
+    let (k, tau) = (1.0 / b, a / b);
     let volts = VoltGains {
-        kp: (2.0 * z + 1.0) * w * w * tau / k,
-        ki: w * w * w * tau / k,
-        kd: (((2.0 * z + 1.0) * w * tau - 1.0) / k).max(0.0),
-        kv: if design.feed_forward { 1.0 / k } else { 0.0 },
-        ka: if design.feed_forward {
-            p.j * p.r / p.kt
-        } else {
-            0.0
-        },
+        kp: (2.0 * z + 1.0) * w * w * a,
+        ki: w * w * w * a,
+        kd: ((2.0 * z + 1.0) * w * a - b).max(0.0),
+        kv: if design.feed_forward { b } else { 0.0 },
+        ka: if design.feed_forward { a } else { 0.0 },
     };
     // Volts to PWM clocks, radians to counts.
     let duty_per_volt = f64::from(timing.pwm_period) / p.vs;
@@ -320,5 +339,46 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("damping"), "{e}");
+    }
+
+    /// With a current-mode drive: the characteristic polynomial `A s³ + (B + Kd) s² + Kp s + Ki`
+    /// of the plant `A θ'' + B θ' = u` (A and B from the drive's full scale, computed here
+    /// from J, b, Kt, I and Vs) vanishes at the placed roots; the feed-forward is the command
+    /// the inertia and the viscous friction need.
+    #[test]
+    fn current_mode_poles_land_where_they_were_placed() {
+        let p = Physical {
+            drive: crate::params::Drive::Current {
+                loop_rad_s: 2.0 * PI * 2500.0,
+                filter_rad_s: 2.0 * PI * 5000.0,
+            },
+            b: 3e-5,
+            ..PlantParams::default_plant().physical()
+        };
+        let g = derive(&p, &LoopDesign::default(), &timing()).unwrap();
+        let per_volt = p.kt * p.i_limit / p.vs;
+        let (a, b) = (p.j / per_volt, p.b / per_volt);
+        let w = 2.0 * PI * g.bandwidth_hz;
+        let z = 0.7;
+        let char_poly = |re: f64, im: f64| {
+            let (s2r, s2i) = (re * re - im * im, 2.0 * re * im);
+            let (s3r, s3i) = (s2r * re - s2i * im, s2r * im + s2i * re);
+            let c2 = b + g.volts.kd;
+            (
+                a * s3r + c2 * s2r + g.volts.kp * re + g.volts.ki,
+                a * s3i + c2 * s2i + g.volts.kp * im,
+            )
+        };
+        for (re, im) in [(-w, 0.0), (-z * w, w * (1.0 - z * z).sqrt())] {
+            let (r, i) = char_poly(re, im);
+            assert!(
+                r.abs() / g.volts.ki < 1e-9 && i.abs() / g.volts.ki < 1e-9,
+                "{r} {i}"
+            );
+        }
+        // Kv ω + Ka α commands the current J α / Kt + b ω / Kt, in volts of full scale.
+        let (omega, alpha) = (30.0, 60.0);
+        let command = (g.volts.kv * omega + g.volts.ka * alpha) / p.vs * p.i_limit;
+        assert!((command - (p.j * alpha + p.b * omega) / p.kt).abs() < 1e-9);
     }
 }

@@ -613,6 +613,11 @@ impl Fit {
         pwm_hz: f64,
         source: &str,
     ) -> Result<PlantParams, IdentifyError> {
+        if base.amplifier.kind != crate::params::AmplifierKind::Voltage {
+            return Err(IdentifyError::Plant(
+                "the model fitted is an H-bridge's: a current-mode drive's plant file cannot be written from it".into(),
+            ));
+        }
         let p = base.physical();
         let m = &self.model;
         let b = ((p.kt / m.gain - p.kt * p.ke) / p.r).max(0.0);

@@ -7,6 +7,12 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+/// A current-mode drive's current-loop bandwidth when the file gives none (Hz): an assumption,
+/// typical of analog brush servo drives (the 12A8's is not published here).
+pub const DEFAULT_CURRENT_LOOP_HZ: f64 = 2500.0;
+/// A current-mode drive's command filter when the file gives none (Hz): an assumption.
+pub const DEFAULT_COMMAND_FILTER_HZ: f64 = 5000.0;
+
 /// The default plant: maxon RE 40 (148877) with seed 001's load, amplifier and encoder.
 pub const DEFAULT_PLANT: &str = include_str!("../motors/re40-148877.toml");
 
@@ -48,17 +54,42 @@ pub struct Load {
     pub inertia_kg_m2: f64,
 }
 
-/// The H-bridge: PWM and direction in, the supply across the motor.
+/// How the amplifier drives the motor.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum AmplifierKind {
+    /// An H-bridge switched by the fabric's PWM and direction: the supply (or 0 V) across the
+    /// motor, with dead time and a cycle-by-cycle current limit.
+    #[default]
+    Voltage,
+    /// A servo drive in current (torque) mode, as seed 001's AMC 12A8 is usually run: the
+    /// fabric's PWM and direction are its command (their average, through the drive's input
+    /// filter), full scale `current_limit_a`; its own current loop sets the motor's current
+    /// within its bandwidth and the supply.
+    Current,
+}
+
+/// The amplifier: PWM and direction in, the motor's voltage (or current) out.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Amplifier {
     /// What it is.
     pub description: String,
+    /// `voltage` (the default: an H-bridge) or `current` (a drive in torque mode).
+    #[serde(default)]
+    pub kind: AmplifierKind,
+    /// A current-mode drive's current-loop bandwidth (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current_loop_hz: Option<f64>,
+    /// A current-mode drive's command input filter (Hz): it averages the PWM.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub command_filter_hz: Option<f64>,
     /// Supply voltage (V).
     pub supply_v: f64,
     /// Dead time after each switching edge (ns).
     pub dead_time_ns: f64,
-    /// Current limit (A): beyond it the bridge stops driving (cycle by cycle).
+    /// Current limit (A): beyond it the bridge stops driving (cycle by cycle); a current-mode
+    /// drive's full-scale current.
     pub current_limit_a: f64,
 }
 
@@ -119,9 +150,25 @@ pub enum PlantError {
     },
 }
 
+/// How the motor is driven, in SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drive {
+    /// The H-bridge.
+    Voltage,
+    /// A current-mode drive.
+    Current {
+        /// Its current loop's bandwidth (rad/s).
+        loop_rad_s: f64,
+        /// Its command filter's corner (rad/s).
+        filter_rad_s: f64,
+    },
+}
+
 /// The plant in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Physical {
+    /// The amplifier's kind.
+    pub drive: Drive,
     /// Armature resistance (Ω).
     pub r: f64,
     /// Armature inductance (H).
@@ -205,7 +252,16 @@ impl PlantParams {
     pub fn physical(&self) -> Physical {
         let m = &self.motor;
         let kt = m.torque_constant_mnm_per_a * 1e-3;
+        let a = &self.amplifier;
+        let hz = |v: Option<f64>, default: f64| 2.0 * PI * v.unwrap_or(default);
         Physical {
+            drive: match a.kind {
+                AmplifierKind::Voltage => Drive::Voltage,
+                AmplifierKind::Current => Drive::Current {
+                    loop_rad_s: hz(a.current_loop_hz, DEFAULT_CURRENT_LOOP_HZ),
+                    filter_rad_s: hz(a.command_filter_hz, DEFAULT_COMMAND_FILTER_HZ),
+                },
+            },
             r: m.terminal_resistance_ohm,
             l: m.terminal_inductance_mh * 1e-3,
             kt,
@@ -264,6 +320,26 @@ impl PlantParams {
         for (field, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(bad(field, v, "give a number ≥ 0"));
+            }
+        }
+        for (field, v) in [
+            ("amplifier.current_loop_hz", self.amplifier.current_loop_hz),
+            (
+                "amplifier.command_filter_hz",
+                self.amplifier.command_filter_hz,
+            ),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(field, v, "give a positive frequency in Hz"));
+                }
+                if self.amplifier.kind != AmplifierKind::Current {
+                    return Err(bad(
+                        field,
+                        v,
+                        "only a current-mode drive has it: set amplifier.kind = \"current\" or remove it",
+                    ));
+                }
             }
         }
         if self.amplifier.dead_time_ns > 10_000.0 {

@@ -15,6 +15,14 @@
 //! * Disabled: every transistor off. A current decays through the diodes against the supply
 //!   (`−Vs·sign(i)`) and stops at zero; then the terminals float (no current, no torque).
 //!
+//! # A current-mode drive (`amplifier.kind = "current"`)
+//!
+//! A servo drive in torque mode, as seed 001's is usually run: the pins' average over each
+//! step (`+1` while `pwm` is high with `dir` low, `−1` with `dir` high) through the drive's
+//! first-order input filter is its command, full scale the current limit; its PI current loop
+//! sets the motor's voltage within the supply ([`Plant`]'s `current_drive`). No dead time: the
+//! drive's own bridge is inside its loop. Disabled, it is off as the bridge is.
+//!
 //! # The encoder
 //!
 //! `count = round(θ / Δ)` with `Δ = 2π / (4 · lines)`: count 0 spans `±Δ/2` around the angle
@@ -23,7 +31,7 @@
 //! (`snapgen_model::peer::Peer::levels`).
 
 use crate::motor::{step, MotorState};
-use crate::params::Physical;
+use crate::params::{Drive, Physical};
 
 /// The fabric's outputs to the power stage, on one clock.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -54,6 +62,11 @@ pub struct Plant {
     // The last step's average voltage.
     volts: f64,
     time: f64,
+    // A current-mode drive: the step's commanded volt-seconds (the pins alone, no dead time),
+    // its command filter's output (−1..1) and its current loop's integrator (V).
+    command_seconds: f64,
+    command: f64,
+    loop_integral: f64,
 }
 
 /// A step that is not a whole number of clocks, or none.
@@ -92,6 +105,9 @@ impl Plant {
             limiting: false,
             volts: 0.0,
             time: 0.0,
+            command_seconds: 0.0,
+            command: 0.0,
+            loop_integral: 0.0,
         })
     }
 
@@ -190,6 +206,7 @@ impl Plant {
             let dead = self.dead_left.min(dt);
             self.dead_left -= dead;
             self.volt_seconds += dead * self.free_wheeling(pins) + (dt - dead) * v;
+            self.command_seconds += self.commanded(pins) * dt;
         }
         self.last = pins;
         self.clocks += 1;
@@ -223,6 +240,7 @@ impl Plant {
                 }
             } else {
                 let v = self.commanded(pins);
+                self.command_seconds += v * self.clock_period * m as f64;
                 if self.limiting && v != 0.0 && v.signum() == self.state.current.signum() {
                     0.0
                 } else {
@@ -240,7 +258,16 @@ impl Plant {
 
     fn integrate(&mut self) {
         let h = f64::from(self.step_clocks) * self.clock_period;
-        let v = self.volt_seconds / h;
+        let mut v = self.volt_seconds / h;
+        if let Drive::Current { .. } = self.p.drive {
+            if self.disabled {
+                // Off: the drive's loop starts again from rest.
+                self.loop_integral = 0.0;
+                self.command = 0.0;
+            } else {
+                v = self.current_drive(h);
+            }
+        }
         let before = self.state.current;
         let mut s = step(&self.p, self.state, v, h);
         if self.disabled && (s.current * before <= 0.0) {
@@ -252,8 +279,34 @@ impl Plant {
         self.limiting = s.current.abs() >= self.p.i_limit;
         self.clocks = 0;
         self.volt_seconds = 0.0;
+        self.command_seconds = 0.0;
         self.disabled = false;
         self.time += h;
+    }
+
+    /// A current-mode drive over the step `h`: the pins' average is its command (through its
+    /// first-order input filter), full scale `i_limit`; its PI current loop, `Kp = L·ω_c`,
+    /// `Ki = R·ω_c` (the zero cancels the armature's pole: the current follows its reference
+    /// as `ω_c / (s + ω_c)`, the back-EMF rejected by the integrator), sets the motor's
+    /// voltage, within the supply (the integrator holds while the output is at it). Returns
+    /// the step's voltage.
+    fn current_drive(&mut self, h: f64) -> f64 {
+        let Drive::Current {
+            loop_rad_s,
+            filter_rad_s,
+        } = self.p.drive
+        else {
+            return self.volt_seconds / h;
+        };
+        let u = self.command_seconds / (h * self.p.vs);
+        self.command += (u - self.command) * (1.0 - (-h * filter_rad_s).exp());
+        let error = self.command * self.p.i_limit - self.state.current;
+        let v = self.p.l * loop_rad_s * error + self.loop_integral;
+        let clamped = v.clamp(-self.p.vs, self.p.vs);
+        if clamped == v {
+            self.loop_integral += self.p.r * loop_rad_s * error * h;
+        }
+        clamped
     }
 }
 
@@ -377,5 +430,59 @@ mod tests {
             assert_eq!(plant.index(), count % 8000 == 0);
         }
         assert!(Plant::new(&p, 10e6, 1e-8).is_err());
+    }
+
+    /// A current-mode drive at a quarter of its command sets a quarter of its full-scale
+    /// current (on average over its PWM periods) while the back-EMF rises, and the shaft
+    /// accelerates as `(Kt i − Tc) / J` says; the other direction, the other sign.
+    #[test]
+    fn a_current_mode_drive_sets_the_current_its_command_asks() {
+        let p = PlantParams::parse(
+            include_str!("../motors/re40-148877-current-drive.toml"),
+            "current-drive",
+        )
+        .unwrap()
+        .physical();
+        for dir in [false, true] {
+            let mut plant = Plant::new(&p, 10e6, 1e-6).unwrap();
+            // 2 ms to settle (the filter and the loop: about 0.1 ms).
+            run(&mut plant, 20_000, 500, 125, dir);
+            let (w0, t0) = (plant.state().omega, plant.time());
+            // 20 ms more (400 PWM periods), the current averaged over every plant step.
+            let mut sum = 0.0;
+            for k in 0..200_000u32 {
+                plant.clock(BridgePins {
+                    pwm: k % 500 < 125,
+                    dir,
+                    enable: true,
+                });
+                if k % 10 == 9 {
+                    sum += plant.state().current;
+                }
+            }
+            let sign = if dir { -1.0 } else { 1.0 };
+            let mean = sum / 20_000.0;
+            assert!(
+                (mean - sign * 0.25 * p.i_limit).abs() < 0.01 * p.i_limit,
+                "{mean}"
+            );
+            let s = plant.state();
+            let alpha = sign * (p.kt * 0.25 * p.i_limit - p.tc) / p.j;
+            let want_w = w0 + alpha * (plant.time() - t0);
+            assert!(
+                (s.omega - want_w).abs() < 0.02 * want_w.abs(),
+                "{s:?} {want_w}"
+            );
+        }
+    }
+
+    #[test]
+    fn current_mode_fields_belong_to_a_current_mode_drive() {
+        let text = crate::params::DEFAULT_PLANT.replace(
+            "current_limit_a = 12.0",
+            "current_limit_a = 12.0\ncurrent_loop_hz = 2000.0",
+        );
+        let e = PlantParams::parse(&text, "x.toml").unwrap_err().to_string();
+        assert!(e.contains("only a current-mode drive has it"), "{e}");
     }
 }

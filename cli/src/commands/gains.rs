@@ -78,9 +78,22 @@ fn configure(g: &Gains, t: &LoopTiming) -> serde_json::Map<String, serde_json::V
 pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
     let p = plant.physical();
     let c = &g.config;
+    let drive = match p.drive {
+        snapgen_plant::params::Drive::Voltage => format!(
+            "H-bridge: K = {:.4} rad/s per V, τ = {:.4} s",
+            g.plant_k, g.plant_tau
+        ),
+        snapgen_plant::params::Drive::Current { loop_rad_s, .. } => format!(
+            "current-mode drive ({:.0} A full scale = {} V of command, its loop {:.0} Hz): J/Kc = {:.4e} V per rad/s²",
+            p.i_limit,
+            p.vs,
+            loop_rad_s / (2.0 * std::f64::consts::PI),
+            snapgen_plant::gains::plant_terms(&p).0
+        ),
+    };
     format!(
         "motor: {}\n\
-         plant: K = {:.4} rad/s per V, τ = {:.4} s (J {:.4e} kg·m², R {} Ω, Kt {} N·m/A), {} counts/rev, supply {} V\n\
+         plant: {} (J {:.4e} kg·m², R {} Ω, Kt {} N·m/A), {} counts/rev, supply {} V\n\
          loop: sample {} ticks of {} s ({:.0} Hz), PWM period {} clocks; bandwidth {:.2} Hz\n\
          \n\
          gain  volts and radians          PWM clocks, counts, samples, ticks   CONFIGURE\n\
@@ -91,8 +104,7 @@ pub fn gains_text(plant: &PlantParams, t: &LoopTiming, g: &Gains) -> String {
          KA    {:>12.5e} V·s²/rad       {:>12.5e} per count/tick²             {}\n\
          INTEGRAL_LIMIT {}  OUTPUT_LIMIT {}  FOLLOWING_LIMIT {} counts  D_FILTER {}  SERVO_PERIOD {}  PWM_PERIOD {}\n",
         plant.motor.name,
-        g.plant_k,
-        g.plant_tau,
+        drive,
         p.j,
         p.r,
         p.kt,

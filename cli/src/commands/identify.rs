@@ -133,6 +133,13 @@ pub struct Report {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let guess = a.motor.load()?;
     let g = guess.physical();
+    if guess.amplifier.kind != snapgen_plant::params::AmplifierKind::Voltage {
+        return Err(InputError::Board(format!(
+            "{}: identification fits an H-bridge's model (voltage in, speed out); a current-mode drive is not identified yet: give a plant file with amplifier.kind = \"voltage\"",
+            guess.motor.name
+        ))
+        .into());
+    }
     let bounds = Bounds {
         travel: a.travel,
         speed: a.speed,
