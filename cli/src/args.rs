@@ -209,9 +209,12 @@ pub struct ServoArgs {
     /// Damping of the complex pole pair.
     #[arg(long, default_value_t = LoopDesign::default().damping)]
     pub damping: f64,
-    /// No velocity and acceleration feed-forward (the seed's controller had none).
+    /// No velocity and acceleration feed-forward.
     #[arg(long)]
     pub no_feed_forward: bool,
+    /// No integrator: a PD controller (two poles placed at the bandwidth, no integral action).
+    #[arg(long)]
+    pub no_integrator: bool,
     /// Following-error limit (rad): beyond it the amplifier goes off (FOLLOWING_ERROR).
     #[arg(long, default_value_t = LoopDesign::default().following_limit_rad)]
     pub following_limit_rad: f64,
@@ -224,6 +227,7 @@ impl ServoArgs {
             bandwidth_hz: self.bandwidth_hz,
             damping: self.damping,
             feed_forward: !self.no_feed_forward,
+            integrator: !self.no_integrator,
             following_limit_rad: self.following_limit_rad,
             ..Default::default()
         }

@@ -50,6 +50,9 @@ pub struct LoopDesign {
     pub damping: f64,
     /// Velocity and acceleration feed-forward on.
     pub feed_forward: bool,
+    /// Integral action (a PID); without it a PD whose two poles are placed at the bandwidth,
+    /// `(s² + 2ζω s + ω²)`: `Kp = A ω²`, `Kd = 2ζω A − B`.
+    pub integrator: bool,
     /// Following-error limit (rad).
     pub following_limit_rad: f64,
     /// Share of the supply the integrator may command (its anti-windup bound).
@@ -64,6 +67,7 @@ impl Default for LoopDesign {
             bandwidth_hz: 20.0,
             damping: 0.7,
             feed_forward: true,
+            integrator: true,
             following_limit_rad: 1.0,
             integral_share: 0.25,
             d_filter_ratio: 10.0,
@@ -207,10 +211,19 @@ pub fn derive(
     // rad/s (for a current-mode drive, a volt is a share `1/Vs` of its full-scale command).
     let (a, b) = plant_terms(p);
     let (k, tau) = (1.0 / b, a / b);
+    let (kp, ki, kd) = if design.integrator {
+        (
+            (2.0 * z + 1.0) * w * w * a,
+            w * w * w * a,
+            ((2.0 * z + 1.0) * w * a - b).max(0.0),
+        )
+    } else {
+        (w * w * a, 0.0, (2.0 * z * w * a - b).max(0.0))
+    };
     let volts = VoltGains {
-        kp: (2.0 * z + 1.0) * w * w * a,
-        ki: w * w * w * a,
-        kd: ((2.0 * z + 1.0) * w * a - b).max(0.0),
+        kp,
+        ki,
+        kd,
         kv: if design.feed_forward { b } else { 0.0 },
         ka: if design.feed_forward { a } else { 0.0 },
     };
@@ -380,5 +393,29 @@ mod tests {
         let (omega, alpha) = (30.0, 60.0);
         let command = (g.volts.kv * omega + g.volts.ka * alpha) / p.vs * p.i_limit;
         assert!((command - (p.j * alpha + p.b * omega) / p.kt).abs() < 1e-9);
+    }
+
+    /// Without the integrator: `A s² + (B + Kd) s + Kp` vanishes at the placed pair, and no
+    /// integral action is left (KI and INTEGRAL_LIMIT 0).
+    #[test]
+    fn a_pd_places_its_two_poles() {
+        let p = PlantParams::default_plant().physical();
+        let d = LoopDesign {
+            integrator: false,
+            bandwidth_hz: 5.0,
+            ..Default::default()
+        };
+        let g = derive(&p, &d, &timing()).unwrap();
+        let (a, b) = (p.j * p.r / p.kt, (p.r * p.b + p.kt * p.ke) / p.kt);
+        let w = 2.0 * PI * 5.0;
+        let (re, im) = (-0.7 * w, w * (1.0f64 - 0.49).sqrt());
+        let (s2r, s2i) = (re * re - im * im, 2.0 * re * im);
+        let r = a * s2r + (b + g.volts.kd) * re + g.volts.kp;
+        let i = a * s2i + (b + g.volts.kd) * im;
+        assert!(
+            r.abs() / g.volts.kp < 1e-9 && i.abs() / g.volts.kp < 1e-9,
+            "{r} {i}"
+        );
+        assert_eq!((g.config.ki, g.config.integral_limit), (0, 0));
     }
 }
