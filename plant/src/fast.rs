@@ -87,6 +87,8 @@ pub struct FastLoop {
     negative: bool,
     period_start: u64,
     tripped: Option<f64>,
+    /// Clocks between a sample and its duty beyond the fabric's LATENCY (a host's loop).
+    delay_clocks: u64,
 }
 
 impl FastLoop {
@@ -116,7 +118,16 @@ impl FastLoop {
             negative: false,
             period_start: 0,
             tripped: None,
+            delay_clocks: 0,
         })
+    }
+
+    /// The controller as a host runs it (seed 001's Raspberry Pi): each duty reaches the PWM
+    /// `seconds` later than the fabric's own controller's would (the encoder's count sent over
+    /// the wire, the control computed, the command sent back), rounded to clocks.
+    pub fn with_transport_delay(mut self, seconds: f64) -> Self {
+        self.delay_clocks = (seconds.max(0.0) * self.timing.clock_hz).round() as u64;
+        self
     }
 
     /// The plant.
@@ -215,7 +226,7 @@ impl FastLoop {
                     s.duty = 0;
                 } else {
                     self.pending
-                        .push_back((self.clock + u64::from(LATENCY), s.duty));
+                        .push_back((self.clock + u64::from(LATENCY) + self.delay_clocks, s.duty));
                 }
                 let st = self.plant.state();
                 sink(&LoopSample {

@@ -388,6 +388,27 @@ mod tests {
         assert!((p.mechanical_time_constant() * 1e3 - 39.5).abs() < 0.5);
     }
 
+    /// Every file in plant/motors/ is a valid plant; the 24 V winding's back-EMF constant is
+    /// half the 48 V winding's (the data sheets' 317 and 158 rpm/V).
+    #[test]
+    fn every_shipped_plant_file_reads() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/motors");
+        let mut n = 0;
+        for e in std::fs::read_dir(dir).unwrap() {
+            let path = e.unwrap().path();
+            if path.extension().is_some_and(|x| x == "toml") {
+                PlantParams::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+                n += 1;
+            }
+        }
+        assert!(n >= 3, "{n}");
+        let low = PlantParams::from_file(&std::path::Path::new(dir).join("re40-148867-24v.toml"))
+            .unwrap()
+            .physical();
+        let ratio = PlantParams::default_plant().physical().ke / low.ke;
+        assert!((ratio - 2.0).abs() < 0.01, "{ratio}");
+    }
+
     #[test]
     fn a_plant_file_written_reads_back() {
         let p = PlantParams::default_plant();

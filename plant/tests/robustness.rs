@@ -113,3 +113,52 @@ fn the_checks_can_fail() {
         .fold(0.0, f64::max);
     assert!(worst > 0.015, "{worst}");
 }
+
+/// The seed's host loop (5 ms) with a transport delay: the duty reaches the PWM later, which
+/// costs tracking (the peak error grows with the delay) and, long enough, the loop's
+/// stability (a delay of several samples: it no longer settles, or trips).
+#[test]
+fn a_transport_delay_costs_the_host_loop() {
+    let p = PlantParams::default_plant().physical();
+    let f = Format {
+        position_lsb: p.rad_per_count(),
+        ..DEFAULT_FORMAT
+    };
+    let g = derive(
+        &p,
+        &LoopDesign::default(),
+        &LoopTiming {
+            ts: f.ts,
+            servo_period: 500,
+            pwm_period: PWM_PERIOD,
+        },
+    )
+    .unwrap();
+    let timing = FabricTiming {
+        clock_hz: CLOCK_HZ,
+        clocks_per_tick: 100,
+        pwm_period: PWM_PERIOD,
+    };
+    let prof = profiles(&f, 0.05, 0.6)
+        .unwrap()
+        .into_iter()
+        .find(|p| p.name == "trapezoid")
+        .unwrap();
+    let run = |delay: f64| {
+        let mut l = FastLoop::new(&p, &f, timing, g.config, 1e-6)
+            .unwrap()
+            .with_transport_delay(delay);
+        let mut samples = Vec::new();
+        l.run_until(prof.moves[0].0, |s| samples.push(*s));
+        l.play(&prof.moves[0].1.program);
+        l.run_until(prof.span.window_end, |s| samples.push(*s));
+        let fig = figures(&samples, &prof.span, SETTLE_BAND, p.vs / 500.0).unwrap();
+        (fig, l.tripped().is_some())
+    };
+    let (none, _) = run(0.0);
+    let (two, tripped) = run(2e-3);
+    assert!(!tripped && two.settle_s.is_some(), "{two:?}");
+    assert!(two.peak_error_rad > none.peak_error_rad, "{none:?} {two:?}");
+    let (long, tripped) = run(40e-3);
+    assert!(tripped || long.settle_s.is_none(), "{long:?}");
+}

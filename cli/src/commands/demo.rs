@@ -267,6 +267,7 @@ pub fn demo(out: &Path) -> anyhow::Result<()> {
         loop_hz: 10_000.0,
         design: snapgen_plant::gains::LoopDesign::default(),
         host_loop: true,
+        transport_delay_s: 0.0,
         short: true,
         step_s: 1e-6,
         out: Some(out.join("seed001")),

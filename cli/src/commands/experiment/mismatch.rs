@@ -13,7 +13,7 @@ use snapgen_plant::metrics::MoveFigures;
 use snapgen_plant::mismatch::{Mismatch, NOMINAL, SWEEP};
 use snapgen_plant::seed001::{profiles, SETTLE_BAND};
 
-use super::{in_parallel, run_profile, servo_ticks, Board, Options, Setup};
+use super::{in_parallel, run_profile, servo_ticks, Board, LoopSetup, Options, Setup};
 use crate::error::{InputError, Mismatched};
 
 /// One profile on one mismatched plant.
@@ -126,7 +126,12 @@ pub fn sweep(o: &Options, cases: &[Mismatch]) -> anyhow::Result<MismatchReport> 
         .collect();
     let done = in_parallel(&jobs, |&(c, k)| {
         let p = cases[c].apply(&nominal);
-        run_profile(o, &design, &f, &p, &gains.config, pwm_period, &all[k])
+        let setup = LoopSetup {
+            servo: gains.config,
+            pwm_period,
+            delay_s: 0.0,
+        };
+        run_profile(o, &design, &f, &p, &setup, &all[k])
             .map_err(|e| e.context(format!("{} with {}", all[k].name, cases[c])))
     });
     let (mut mismatches, mut clocks) = (0, 0);

@@ -64,6 +64,12 @@ pub struct Args {
     /// Leave out the 5 ms host-loop runs.
     #[arg(long)]
     no_host_loop: bool,
+    /// The 5 ms host loops' transport delay (ms): each duty reaches the PWM this much later
+    /// than the fabric's controller's (the seed's Raspberry Pi: the count over the UART, the
+    /// control computed, the command back). `--board fast` only: the fabric's controller has
+    /// none.
+    #[arg(long, default_value_t = 0.0)]
+    transport_delay_ms: f64,
     /// The fabric clock (Hz).
     #[arg(long, default_value_t = EXPERIMENT_CLOCK_HZ)]
     clock_hz: f64,
@@ -98,7 +104,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if !(a.transport_delay_ms.is_finite() && (0.0..=1000.0).contains(&a.transport_delay_ms)) {
+        return Err(InputError::Board(format!(
+            "--transport-delay-ms {}: give 0 to 1000 ms",
+            a.transport_delay_ms
+        ))
+        .into());
+    }
+    if a.transport_delay_ms > 0.0 && a.board != Board::Fast {
+        return Err(InputError::Board(
+            "--transport-delay-ms models a host's loop: it runs on --board fast only (the fabric's controller, and its model, have no transport delay)".into(),
+        )
+        .into());
+    }
     let o = Options {
+        transport_delay_s: a.transport_delay_ms * 1e-3,
         board: a.board,
         plant,
         clock_hz: a.clock_hz,
@@ -168,6 +188,8 @@ pub struct Options {
     pub design: LoopDesign,
     /// Also the seed's 5 ms host-loop rate.
     pub host_loop: bool,
+    /// The host loops' transport delay (s; `fast` only).
+    pub transport_delay_s: f64,
     /// Only the S-curve and the trapezoid, with a shorter watch after each.
     pub short: bool,
     /// The plant's integration step (s).
@@ -327,10 +349,11 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
         pwm_period,
     } = Setup::of(o)?;
     let ticks = |hz: f64| servo_ticks(&f, hz);
-    let mut loops = vec![("fabric", ticks(o.loop_hz), o.design.feed_forward)];
+    let mut loops = vec![("fabric", ticks(o.loop_hz), o.design.feed_forward, 0.0)];
     if o.host_loop {
-        loops.push(("host 5 ms", ticks(200.0), o.design.feed_forward));
-        loops.push(("host 5 ms, PID only", ticks(200.0), false));
+        let d = o.transport_delay_s;
+        loops.push(("host 5 ms", ticks(200.0), o.design.feed_forward, d));
+        loops.push(("host 5 ms, feedback only", ticks(200.0), false, d));
     }
     let window = if o.short { 0.5 } else { 1.2 };
     let mut all = profiles(&f, 0.05, window)?;
@@ -339,7 +362,7 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
     }
     let (mut mismatches, mut clocks) = (0u64, 0u64);
     let mut gains = Vec::new();
-    for &(_, period, ff) in &loops {
+    for &(_, period, ff, _) in &loops {
         gains.push(derive(
             &p,
             &LoopDesign {
@@ -358,7 +381,12 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
         .flat_map(|l| (0..all.len()).map(move |k| (l, k)))
         .collect();
     let done = in_parallel(&jobs, |&(l, k)| {
-        run_profile(o, &design, &f, &p, &gains[l].config, pwm_period, &all[k])
+        let setup = LoopSetup {
+            servo: gains[l].config,
+            pwm_period,
+            delay_s: loops[l].3,
+        };
+        run_profile(o, &design, &f, &p, &setup, &all[k])
             .with_context(|| format!("{} on the {} loop", all[k].name, loops[l].0))
     });
     let mut per_loop: Vec<Vec<ProfileResult>> = vec![Vec::new(); loops.len()];
@@ -369,12 +397,19 @@ pub fn play(o: &Options) -> anyhow::Result<Report> {
         per_loop[l].push(r.result);
     }
     let mut results = Vec::new();
-    for ((name, period, ff), (gains, out)) in loops.into_iter().zip(gains.iter().zip(per_loop)) {
+    for ((name, period, ff, delay), (gains, out)) in
+        loops.into_iter().zip(gains.iter().zip(per_loop))
+    {
         results.push(LoopResult {
             name: format!(
-                "{name} ({:.0} Hz{})",
+                "{name} ({:.0} Hz{}{})",
                 1.0 / (f64::from(period) * f.ts),
-                if ff { ", feed-forward" } else { "" }
+                if ff { ", feed-forward" } else { "" },
+                if delay > 0.0 {
+                    format!(", {:.1} ms delay", delay * 1e3)
+                } else {
+                    String::new()
+                }
             ),
             loop_hz: 1.0 / (f64::from(period) * f.ts),
             feed_forward: ff,
@@ -437,16 +472,23 @@ struct Run {
     following_peak_rad: f64,
 }
 
+/// One loop's controller: its registers, the PWM period and a host's transport delay (s).
+struct LoopSetup {
+    servo: ServoConfig,
+    pwm_period: u16,
+    delay_s: f64,
+}
+
 /// One profile on one loop.
 fn run_profile(
     o: &Options,
     design: &Design,
     f: &Format,
     p: &Physical,
-    servo: &ServoConfig,
-    pwm_period: u16,
+    setup: &LoopSetup,
     prof: &Profile,
 ) -> anyhow::Result<Run> {
+    let (servo, pwm_period) = (&setup.servo, setup.pwm_period);
     let volts_per_duty = p.vs / f64::from(pwm_period);
     let last_end = prof.span.window_end;
     let record_every = (f64::from(design.clock_hz) * 1e-4).round().max(1.0) as u64;
@@ -457,7 +499,8 @@ fn run_profile(
                 clocks_per_tick: u64::from(design.dividers.tick_div) + 1,
                 pwm_period,
             };
-            let mut l = FastLoop::new(p, f, timing, *servo, o.step_s)?;
+            let mut l =
+                FastLoop::new(p, f, timing, *servo, o.step_s)?.with_transport_delay(setup.delay_s);
             let mut samples = Vec::new();
             let mut starts = Vec::new();
             for (t, plan) in &prof.moves {
