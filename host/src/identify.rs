@@ -4,11 +4,12 @@
 //!
 //! The board is configured with the given controller (a low-bandwidth one derived from the
 //! data sheet's plant: the excitation is the loop's own duty, whatever the motor really is),
-//! its following-error limit armed and its duty bounded by OUTPUT_LIMIT, and TELEMETRY_PERIOD
+//! its following-error limit armed and its duty bounded by its OUTPUT_LIMIT, and TELEMETRY_PERIOD
 //! set to SERVO_PERIOD, so each frame carries one controller sample: the encoder's count and the
 //! duty then. Each move of the excitation is uploaded, started and recorded to its end; the
 //! watchdog covers each move (it is set to the longest move and a second). A following-error
-//! trip ends the recording with the board's error. The amplifier is switched off at the end.
+//! trip ends the recording with the board's error. However it ends, the axis is brought to
+//! rest and its amplifier switched off ([`record`]).
 
 use snapgen_model::io::servo::ServoConfig;
 use snapgen_model::stop::StopLimits;
@@ -39,8 +40,49 @@ pub struct Excitation {
 /// One move's frames, in the order they came.
 pub type MoveFrames = Vec<Status>;
 
-/// Plays `e` on the board of `s` and returns each move's TELEMETRY frames.
+/// Plays `e` on the board of `s` and returns each move's TELEMETRY frames. Whatever ends it —
+/// the last move, a following-error trip, a refusal or a lost link — the axis is stopped (STOP,
+/// waited for) and its amplifier switched off before this returns; the host watchdog is set
+/// back as it was.
 pub fn record<L: Link>(s: &mut Session<L>, e: &Excitation) -> Result<Vec<MoveFrames>, HostError> {
+    let watchdog = s.read_config(Param::WatchdogMs)?;
+    let out = play(s, e);
+    let off = shut_down(s);
+    // The host watchdog as it was, whatever happened.
+    let restored = s.configure(Param::WatchdogMs, watchdog);
+    let frames = out?;
+    off?;
+    restored?;
+    Ok(frames)
+}
+
+/// STOP if the axis moves, wait for it to rest (two seconds at most), POWER 0.
+fn shut_down<L: Link>(s: &mut Session<L>) -> Result<(), HostError> {
+    let mut st = s.status()?;
+    if matches!(
+        st.axis(),
+        Some(AxisState::DiscreteMotion | AxisState::Stopping)
+    ) {
+        let _ = s.expect_ack(&Command::Stop);
+        for _ in 0..40 {
+            s.link.wait(0.05);
+            st = s.status()?;
+            if !matches!(
+                st.axis(),
+                Some(AxisState::DiscreteMotion | AxisState::Stopping)
+            ) {
+                break;
+            }
+        }
+    }
+    match st.axis() {
+        // Already off (Disabled), or off by the trip (ErrorStop: the amplifier is off).
+        Some(AxisState::Disabled | AxisState::ErrorStop) => Ok(()),
+        _ => s.expect_ack(&Command::Power { on: false }),
+    }
+}
+
+fn play<L: Link>(s: &mut Session<L>, e: &Excitation) -> Result<Vec<MoveFrames>, HostError> {
     let ts = s.format.ts;
     let longest = e
         .moves
@@ -85,7 +127,6 @@ pub fn record<L: Link>(s: &mut Session<L>, e: &Excitation) -> Result<Vec<MoveFra
         }
         let axis = st.axis().unwrap_or(AxisState::ErrorStop);
         if axis != AxisState::Standstill {
-            let _ = s.expect_ack(&Command::Power { on: false });
             return Err(HostError::Stopped {
                 error: st.error_id().unwrap_or_default(),
                 state: axis,
@@ -94,7 +135,6 @@ pub fn record<L: Link>(s: &mut Session<L>, e: &Excitation) -> Result<Vec<MoveFra
         }
         out.push(frames);
     }
-    s.expect_ack(&Command::Power { on: false })?;
     Ok(out)
 }
 

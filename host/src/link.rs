@@ -27,10 +27,8 @@ pub trait Link {
     /// The last TELEMETRY received, once (those before it are dropped).
     fn take_telemetry(&mut self) -> Option<Status>;
     /// Every TELEMETRY received since the last call, in order (a recording: identification),
-    /// up to [`TELEMETRY_KEPT`] of them. Links that keep only the last give that one.
-    fn drain_telemetry(&mut self) -> Vec<Status> {
-        self.take_telemetry().into_iter().collect()
-    }
+    /// up to [`TELEMETRY_KEPT`] of them.
+    fn drain_telemetry(&mut self) -> Vec<Status>;
     /// The host's clock (s): wall time, or a virtual board's own time.
     fn now(&self) -> f64;
     /// Lets `seconds` pass (receiving meanwhile).

@@ -125,8 +125,14 @@ impl FastLoop {
     /// The controller as a host runs it (seed 001's Raspberry Pi): each duty reaches the PWM
     /// `seconds` later than the fabric's own controller's would (the encoder's count sent over
     /// the wire, the control computed, the command sent back), rounded to clocks.
+    /// A delay that is not a finite number of seconds ≥ 0 is taken as none.
     pub fn with_transport_delay(mut self, seconds: f64) -> Self {
-        self.delay_clocks = (seconds.max(0.0) * self.timing.clock_hz).round() as u64;
+        let clocks = seconds * self.timing.clock_hz;
+        self.delay_clocks = if clocks.is_finite() && clocks > 0.0 {
+            clocks.round().min(1e15) as u64
+        } else {
+            0
+        };
         self
     }
 

@@ -364,6 +364,8 @@ mod tests {
             drive: crate::params::Drive::Current {
                 loop_rad_s: 2.0 * PI * 2500.0,
                 filter_rad_s: 2.0 * PI * 5000.0,
+                kp: 5.0,
+                ki: 2e4,
             },
             b: 3e-5,
             ..PlantParams::default_plant().physical()

@@ -428,7 +428,7 @@ fn normal<const N: usize>(
 
 /// The model simulated from rest on a segment's voltages: its speed at each sample.
 pub fn simulate(m: &Model, volts: &[f64], period: f64, e: Option<&Electrical>) -> Vec<f64> {
-    let sub = ((period / (m.tau / 20.0)).ceil() as usize).max(1);
+    let sub = ((period / (m.tau / 20.0)).ceil() as usize).clamp(1, 1000);
     let dt = period / sub as f64;
     let decay = (-dt / m.tau).exp();
     let mut w = 0.0f64;
@@ -559,7 +559,8 @@ fn identify_aligned(r: &Record, dead_zone: Option<f64>) -> Result<Fit, IdentifyE
         let mode = if pass == 0 { Some(0.0) } else { dead_zone };
         let (x, ss, rows) = least_squares(&prepared, r, lambda, (gain, dz), mode)
             .ok_or(IdentifyError::TooLittleMotion { moving, needed })?;
-        if !(x[1] > 0.0 && x[0] > 0.0) {
+        // A time constant below a tenth of the sample period is not one the record shows.
+        if !(x[1] > 0.0 && x[0] > 0.1 * r.period) {
             return Err(IdentifyError::NotAMotor {
                 gain: x[1],
                 tau: x[0],

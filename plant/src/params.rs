@@ -161,6 +161,12 @@ pub enum Drive {
         loop_rad_s: f64,
         /// Its command filter's corner (rad/s).
         filter_rad_s: f64,
+        /// Its PI current loop's gains, tuned once to the plant file's winding: `L·ω_c` (V/A)
+        /// and `R·ω_c` (V/(A·s)). A winding that differs later (hot: `snapgen_plant::mismatch`)
+        /// keeps the drive's tuning.
+        kp: f64,
+        /// The integral gain.
+        ki: f64,
     },
 }
 
@@ -257,10 +263,15 @@ impl PlantParams {
         Physical {
             drive: match a.kind {
                 AmplifierKind::Voltage => Drive::Voltage,
-                AmplifierKind::Current => Drive::Current {
-                    loop_rad_s: hz(a.current_loop_hz, DEFAULT_CURRENT_LOOP_HZ),
-                    filter_rad_s: hz(a.command_filter_hz, DEFAULT_COMMAND_FILTER_HZ),
-                },
+                AmplifierKind::Current => {
+                    let loop_rad_s = hz(a.current_loop_hz, DEFAULT_CURRENT_LOOP_HZ);
+                    Drive::Current {
+                        loop_rad_s,
+                        filter_rad_s: hz(a.command_filter_hz, DEFAULT_COMMAND_FILTER_HZ),
+                        kp: m.terminal_inductance_mh * 1e-3 * loop_rad_s,
+                        ki: m.terminal_resistance_ohm * loop_rad_s,
+                    }
+                }
             },
             r: m.terminal_resistance_ohm,
             l: m.terminal_inductance_mh * 1e-3,

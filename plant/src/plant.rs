@@ -286,14 +286,16 @@ impl Plant {
 
     /// A current-mode drive over the step `h`: the pins' average is its command (through its
     /// first-order input filter), full scale `i_limit`; its PI current loop, `Kp = L·ω_c`,
-    /// `Ki = R·ω_c` (the zero cancels the armature's pole: the current follows its reference
-    /// as `ω_c / (s + ω_c)`, the back-EMF rejected by the integrator), sets the motor's
-    /// voltage, within the supply (the integrator holds while the output is at it). Returns
-    /// the step's voltage.
+    /// `Ki = R·ω_c` of the plant file's winding (the zero cancels the armature's pole: the
+    /// current follows its reference as `ω_c / (s + ω_c)`, the back-EMF rejected by the
+    /// integrator), sets the motor's voltage, within the supply (the integrator holds while the
+    /// output is at it). Returns the step's voltage.
     fn current_drive(&mut self, h: f64) -> f64 {
         let Drive::Current {
-            loop_rad_s,
             filter_rad_s,
+            kp,
+            ki,
+            ..
         } = self.p.drive
         else {
             return self.volt_seconds / h;
@@ -301,10 +303,10 @@ impl Plant {
         let u = self.command_seconds / (h * self.p.vs);
         self.command += (u - self.command) * (1.0 - (-h * filter_rad_s).exp());
         let error = self.command * self.p.i_limit - self.state.current;
-        let v = self.p.l * loop_rad_s * error + self.loop_integral;
+        let v = kp * error + self.loop_integral;
         let clamped = v.clamp(-self.p.vs, self.p.vs);
         if clamped == v {
-            self.loop_integral += self.p.r * loop_rad_s * error * h;
+            self.loop_integral += ki * error * h;
         }
         clamped
     }

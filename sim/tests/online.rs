@@ -449,6 +449,9 @@ impl<L: Link> Link for GapLink<L> {
     fn take_telemetry(&mut self) -> Option<Status> {
         self.inner.take_telemetry()
     }
+    fn drain_telemetry(&mut self) -> Vec<Status> {
+        self.inner.drain_telemetry()
+    }
     fn now(&self) -> f64 {
         self.inner.now()
     }

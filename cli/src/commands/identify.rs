@@ -53,7 +53,7 @@ pub struct Args {
     #[command(flatten)]
     link: BoardLinkArgs,
     /// Without --port: the virtual board.
-    #[arg(long, value_enum, default_value = "fabric")]
+    #[arg(long, value_enum, default_value = "fabric", conflicts_with_all = ["port", "uio"])]
     board: Virtual,
     /// The virtual board's motor (a plant file) [default: --motor].
     #[arg(long, conflicts_with_all = ["port", "uio"])]
@@ -61,9 +61,15 @@ pub struct Args {
     /// The virtual board's motor differs from --plant by these factors (r=…,j=…,friction=…).
     #[arg(long, conflicts_with_all = ["port", "uio"])]
     mismatch: Option<String>,
-    /// The excitation's largest excursion from where the shaft stands, one way (rad).
-    #[arg(long, default_value_t = 8.0)]
-    travel: f64,
+    /// The excitation's largest excursion from where the shaft stands, one way (rad); with
+    /// --port or --uio it must be given (the machine's room, not a default) [virtual board:
+    /// 8].
+    #[arg(long)]
+    travel: Option<f64>,
+    /// The largest duty the excitation's controller may command, a share of the PWM period
+    /// (its OUTPUT_LIMIT).
+    #[arg(long, default_value_t = 0.3)]
+    max_duty: f64,
     /// Its largest speed (rad/s).
     #[arg(long, default_value_t = 40.0)]
     speed: f64,
@@ -140,13 +146,57 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ))
         .into());
     }
+    let real = a.link.port.is_some() || a.link.uio.is_some();
+    let travel = match (a.travel, real) {
+        (Some(t), _) => t,
+        (None, false) => 8.0,
+        (None, true) => {
+            return Err(InputError::Board(
+                "--travel: give the excitation's excursion in rad, what the machine has room for on both sides of where it stands (see the coast distance this prints)".into(),
+            )
+            .into())
+        }
+    };
     let bounds = Bounds {
-        travel: a.travel,
+        travel,
         speed: a.speed,
         accel: a.accel,
     };
+    if !(a.max_duty.is_finite() && a.max_duty > 0.0 && a.max_duty <= 1.0) {
+        return Err(InputError::Board(format!(
+            "--max-duty {}: give a share of the PWM period in (0, 1]",
+            a.max_duty
+        ))
+        .into());
+    }
+    // One TELEMETRY frame a sample: the wire must carry it in less than a sample.
+    let frame_s = 10.0 * (snapgen_spec::Status::BYTES + snapgen_spec::wire::OVERHEAD) as f64
+        / f64::from(a.link.baud);
+    if a.sample_hz * frame_s > 0.8 {
+        return Err(InputError::Board(format!(
+            "--sample-hz {}: a TELEMETRY frame takes {:.2} ms at {} baud, more than 80 % of a sample: give at most {:.0} Hz or a faster baud",
+            a.sample_hz,
+            frame_s * 1e3,
+            a.link.baud,
+            0.8 / frame_s
+        ))
+        .into());
+    }
+    // If the loop trips at full speed the amplifier is off and the shaft coasts against its
+    // Coulomb friction alone: J ω² / (2 Tc).
+    let coast = if g.tc > 0.0 {
+        g.j * a.speed * a.speed / (2.0 * g.tc)
+    } else {
+        f64::INFINITY
+    };
+    eprintln!(
+        "identify: moves within {travel} rad of where the shaft stands, up to {} rad/s and {} rad/s², duty at most {:.0} %; a trip at full speed lets the shaft coast about {coast:.1} rad more (the data sheet's inertia and friction)",
+        a.speed,
+        a.accel,
+        a.max_duty * 100.0
+    );
     for (flag, v) in [
-        ("--travel", a.travel),
+        ("--travel", travel),
         ("--speed", a.speed),
         ("--accel", a.accel),
         ("--sample-hz", a.sample_hz),
@@ -207,8 +257,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         guess.motor.name,
         if report.fit.dead_zone_fitted { ", and the dead time," } else { "" }
     );
-    std::fs::write(&a.out, fitted.to_toml(&head))
-        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    let text = fitted.to_toml(&head);
+    // The file must be one the other commands read: a fit that leaves the data sheet's rules
+    // (a dead time past 10 µs, a friction past the nominal voltage) is refused, not written.
+    PlantParams::parse(&text, &a.out.display().to_string()).map_err(|e| {
+        InputError::Board(format!(
+            "the fitted plant is not a valid plant file ({e}): check the record (the fit explains {:.1} %)",
+            report.fit.simulation_fit_percent
+        ))
+    })?;
+    std::fs::write(&a.out, text).with_context(|| format!("cannot write {}", a.out.display()))?;
     let timing = a.servo.timing(f64::from(report.clock_hz), report.ts)?;
     let gains = derive(&fitted.physical(), &a.servo.design(), &timing)
         .map_err(|e| InputError::Board(e.to_string()))?;
@@ -249,7 +307,9 @@ fn measure<L: Link>(
     truth: Option<&snapgen_plant::Physical>,
 ) -> anyhow::Result<(Report, PlantParams)> {
     let g = guess.physical();
-    let setup = servo_setup(s, &options(a, guess)).map_err(InputError::Host)?;
+    let mut setup = servo_setup(s, &options(a, guess)).map_err(InputError::Host)?;
+    setup.config.output_limit =
+        ((a.max_duty * f64::from(setup.pwm_period)).round() as u16).clamp(1, setup.pwm_period);
     // The board's format, one output LSB an encoder count.
     let f = snapgen_model::Format {
         position_lsb: g.rad_per_count(),

@@ -144,7 +144,7 @@ pub struct ExecutorLink<'l, S: CoreSide = Lockstep> {
     owed: f64,
     /// The first mismatch: every request fails after it.
     mismatch: Option<S::Mismatch>,
-    telemetry: Option<Status>,
+    telemetry: std::collections::VecDeque<Status>,
 }
 
 impl<'l, S: CoreSide> ExecutorLink<'l, S> {
@@ -188,7 +188,7 @@ impl<'l, S: CoreSide> ExecutorLink<'l, S> {
             byte_time: (10.0 / baud).max(1.0 / f64::from(design.clock_hz)),
             owed: 0.0,
             mismatch: None,
-            telemetry: None,
+            telemetry: std::collections::VecDeque::new(),
         }
     }
 
@@ -217,7 +217,11 @@ impl<'l, S: CoreSide> ExecutorLink<'l, S> {
             self.mismatch = Some(m);
         }
         if std::mem::take(&mut self.board.telemetry) {
-            self.telemetry = Some(self.live().status);
+            if self.telemetry.len() == snapgen_host::link::TELEMETRY_KEPT {
+                self.telemetry.pop_front();
+            }
+            let status = self.live().status;
+            self.telemetry.push_back(status);
         }
     }
 
@@ -320,7 +324,13 @@ impl<S: CoreSide> Link for ExecutorLink<'_, S> {
     }
 
     fn take_telemetry(&mut self) -> Option<Status> {
-        self.telemetry.take()
+        let last = self.telemetry.pop_back();
+        self.telemetry.clear();
+        last
+    }
+
+    fn drain_telemetry(&mut self) -> Vec<Status> {
+        self.telemetry.drain(..).collect()
     }
 
     fn now(&self) -> f64 {

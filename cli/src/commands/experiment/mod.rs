@@ -83,7 +83,7 @@ pub struct Args {
     /// S-curve and the trapezoid run on the fabric-rate loop with plants that differ from it,
     /// each case factors `r=1.4,j=0.7,friction=2` (resistance, inertia, Coulomb and viscous
     /// friction; a factor left out is 1), after the nominal plant. Without a case: the standard sweep (nominal, R +40 %,
-    /// J ±30 %, friction ×2 and the two corners).
+    /// J ±30 %, friction ×2 and the two corners). Writes no plots.
     #[arg(long, num_args = 0.., value_name = "CASE")]
     mismatch: Option<Vec<String>>,
     #[command(flatten)]
@@ -132,6 +132,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         out: Some(a.out),
     };
     if let Some(cases) = &a.mismatch {
+        if o.transport_delay_s > 0.0 {
+            return Err(InputError::Board(
+                "--mismatch runs the fabric-rate loop only: --transport-delay-ms (the 5 ms host loops') does not apply".into(),
+            )
+            .into());
+        }
         return mismatch::run(&o, cases, a.json);
     }
     let r = play(&o)?;
