@@ -25,13 +25,14 @@ cd "$(dirname "$0")/.."
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(aarch64 armv7)
 # Per target: Rust's triple, the cross gcc and its Debian packages, qemu-user's binary and
-# sysroot, the ELF e_machine (bytes 18-19 of the binary), the build directory.
+# sysroot, the ELF e_machine (bytes 18-19 of the binary). Both targets build in the workspace's
+# target directory (target/TRIPLE), so the build scripts and proc macros that run on this
+# machine are the x86 build's, not built again.
 triple() { case "$1" in aarch64) echo aarch64-unknown-linux-gnu ;; armv7) echo armv7-unknown-linux-gnueabihf ;; *) echo "unknown target $1: aarch64 or armv7" >&2; exit 2 ;; esac; }
 gcc_of() { case "$1" in aarch64) echo aarch64-linux-gnu-gcc ;; armv7) echo arm-linux-gnueabihf-gcc ;; esac; }
 debs_of() { case "$1" in aarch64) echo gcc-aarch64-linux-gnu libc6-dev-arm64-cross ;; armv7) echo gcc-arm-linux-gnueabihf libc6-dev-armhf-cross ;; esac; }
 qemu_of() { case "$1" in aarch64) echo "qemu-aarch64 -L /usr/aarch64-linux-gnu" ;; armv7) echo "qemu-arm -L /usr/arm-linux-gnueabihf" ;; esac; }
 machine_of() { case "$1" in aarch64) echo b700 ;; armv7) echo 2800 ;; esac; }
-dir_of() { case "$1" in aarch64) echo arm64 ;; armv7) echo armv7 ;; esac; }
 
 need_apt=()
 for t in "${targets[@]}"; do
@@ -83,9 +84,9 @@ for t in "${targets[@]}"; do
   rustup target list --installed 2>/dev/null | grep -qx "$target" || rustup target add "$target"
   echo "== cross-building snapgen for $target"
   linker_var="CARGO_TARGET_$(echo "$target" | tr 'a-z-' 'A-Z_')_LINKER"
-  env "$linker_var=$(gcc_of "$t")" CARGO_TARGET_DIR="$tdir/$(dir_of "$t")" \
+  env "$linker_var=$(gcc_of "$t")" \
     cargo build --release --quiet --target "$target" -p snapgen-cli
-  arm=$tdir/$(dir_of "$t")/$target/release/snapgen
+  arm=$tdir/$target/release/snapgen
   [ "$(od -An -tx1 -j18 -N2 "$arm" | tr -d ' ')" = "$(machine_of "$t")" ] || { echo "$arm is not an $t binary" >&2; exit 1; }
   read -r -a qemu <<<"$(qemu_of "$t")"
 

@@ -516,7 +516,8 @@ impl BoardSynth {
             .unwrap_or_default()
     }
 
-    /// Budget violations of the motion core (empty when within budget).
+    /// Budget violations of the motion core, and any design that synthesises with a latch
+    /// (empty when within budget).
     pub fn violations(&self) -> Vec<String> {
         let mut v = Vec::new();
         let block = self.core_block();
@@ -538,6 +539,22 @@ impl BoardSynth {
                 "motion core logic-only path is {:.2} ns, budget {CORE_PATH_BUDGET_NS} ns",
                 block.path_ns
             ));
+        }
+        for (name, r) in [
+            ("the board top", &self.full),
+            ("the motion core", &self.core),
+            ("the path interpolator", &self.interpolator),
+            ("the path sequencer", &self.path_sequencer),
+            ("the path steppers", &self.path_steppers),
+            ("the path core", &self.path_core),
+            ("the step/dir generator", &self.step_dir),
+        ] {
+            if r.resources.latches() > 0 {
+                v.push(format!(
+                    "{name} synthesises with {} latches (a combinational output not assigned on every path)",
+                    r.resources.latches()
+                ));
+            }
         }
         v
     }
@@ -640,56 +657,90 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
     plan.write(&dir)?;
     let top = b.top_name();
     let core_file = dir.join("snapgen_core.v");
-    let full = crate::yosys::synth(
-        &[
-            core_file.clone(),
-            dir.join("snapgen_io.v"),
-            dir.join(format!("{top}.v")),
-        ],
-        &top,
-        &b.family,
-    )?;
-    let core = crate::yosys::synth(&[core_file], snapgen_hdl::verilog::CORE_PREFIX, &b.family)?;
-    let prefix = snapgen_hdl::interpolator::INTERPOLATOR_PREFIX;
-    let file = dir.join(format!("{prefix}.v"));
-    std::fs::write(
-        &file,
-        snapgen_hdl::interpolator::interpolator_verilog(INTERPOLATOR_AXES),
-    )
-    .with_context(|| format!("cannot write {}", file.display()))?;
-    let interpolator = crate::yosys::synth(&[file], prefix, &b.family)?;
-    let prefix = snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX;
-    let file = dir.join(format!("{prefix}.v"));
-    std::fs::write(
-        &file,
-        snapgen_hdl::path_sequencer::path_sequencer_verilog(INTERPOLATOR_AXES),
-    )
-    .with_context(|| format!("cannot write {}", file.display()))?;
-    let path_sequencer = crate::yosys::synth(&[file], prefix, &b.family)?;
-    let mut files = Vec::new();
-    for (name, text) in snapgen_hdl::path_steppers::path_steppers_sources(INTERPOLATOR_AXES) {
-        let file = dir.join(format!("steppers_{name}"));
+    // Each design's files and top module, written first; then one Yosys per design, all at
+    // once (each is one process on one core; they share nothing).
+    let write = |name: String, text: String| -> anyhow::Result<PathBuf> {
+        let file = dir.join(name);
         std::fs::write(&file, text).with_context(|| format!("cannot write {}", file.display()))?;
-        files.push(file);
-    }
-    let path_steppers = crate::yosys::synth(
-        &files,
-        snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX,
-        &b.family,
-    )?;
-    let mut files = Vec::new();
-    for (name, text) in snapgen_hdl::path_core::path_core_sources(INTERPOLATOR_AXES) {
-        let file = dir.join(format!("path_core_{name}"));
-        std::fs::write(&file, text).with_context(|| format!("cannot write {}", file.display()))?;
-        files.push(file);
-    }
-    let path_core =
-        crate::yosys::synth(&files, snapgen_hdl::path_core::PATH_CORE_PREFIX, &b.family)?;
-    let prefix = snapgen_hdl::step_dir::STEP_DIR_PREFIX;
-    let file = dir.join(format!("{prefix}.v"));
-    std::fs::write(&file, snapgen_hdl::step_dir::step_dir_verilog())
-        .with_context(|| format!("cannot write {}", file.display()))?;
-    let step_dir = crate::yosys::synth(&[file], prefix, &b.family)?;
+        Ok(file)
+    };
+    let sources = |prefix: &str, files: Vec<(String, String)>| -> anyhow::Result<Vec<PathBuf>> {
+        files
+            .into_iter()
+            .map(|(name, text)| write(format!("{prefix}_{name}"), text))
+            .collect()
+    };
+    let jobs: Vec<(Vec<PathBuf>, String)> = vec![
+        (
+            vec![
+                core_file.clone(),
+                dir.join("snapgen_io.v"),
+                dir.join(format!("{top}.v")),
+            ],
+            top.clone(),
+        ),
+        (
+            vec![core_file],
+            snapgen_hdl::verilog::CORE_PREFIX.to_string(),
+        ),
+        (
+            vec![write(
+                format!("{}.v", snapgen_hdl::interpolator::INTERPOLATOR_PREFIX),
+                snapgen_hdl::interpolator::interpolator_verilog(INTERPOLATOR_AXES),
+            )?],
+            snapgen_hdl::interpolator::INTERPOLATOR_PREFIX.to_string(),
+        ),
+        (
+            vec![write(
+                format!("{}.v", snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX),
+                snapgen_hdl::path_sequencer::path_sequencer_verilog(INTERPOLATOR_AXES),
+            )?],
+            snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX.to_string(),
+        ),
+        (
+            sources(
+                "steppers",
+                snapgen_hdl::path_steppers::path_steppers_sources(INTERPOLATOR_AXES).to_vec(),
+            )?,
+            snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX.to_string(),
+        ),
+        (
+            sources(
+                "path_core",
+                snapgen_hdl::path_core::path_core_sources(INTERPOLATOR_AXES),
+            )?,
+            snapgen_hdl::path_core::PATH_CORE_PREFIX.to_string(),
+        ),
+        (
+            vec![write(
+                format!("{}.v", snapgen_hdl::step_dir::STEP_DIR_PREFIX),
+                snapgen_hdl::step_dir::step_dir_verilog(),
+            )?],
+            snapgen_hdl::step_dir::STEP_DIR_PREFIX.to_string(),
+        ),
+    ];
+    let family = &b.family;
+    let reports: Vec<anyhow::Result<crate::yosys::SynthReport>> = std::thread::scope(|s| {
+        let running: Vec<_> = jobs
+            .iter()
+            .map(|(files, top)| s.spawn(move || crate::yosys::synth(files, top, family)))
+            .collect();
+        running
+            .into_iter()
+            .map(|h| h.join().expect("a Yosys run's thread panicked"))
+            .collect()
+    });
+    let mut reports = reports.into_iter();
+    let mut next = || reports.next().expect("one report per design");
+    let (full, core, interpolator, path_sequencer, path_steppers, path_core, step_dir) = (
+        next()?,
+        next()?,
+        next()?,
+        next()?,
+        next()?,
+        next()?,
+        next()?,
+    );
     let _ = std::fs::remove_dir_all(&dir);
     Ok(BoardSynth {
         board: b.clone(),

@@ -320,30 +320,6 @@ fn zero_distance_is_fine() {
 }
 
 #[test]
-fn demo_runs_and_writes_plots() {
-    let dir = tmp("demo");
-    let out = snapgen(&["demo", "--out", dir.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert_ok(&out);
-    assert!(stdout.contains("round trip 0 -> 12π -> 0 ends on the start register bit for bit"));
-    assert!(stdout.contains(", 0 mismatches"), "{stdout}");
-    assert!(stdout.contains(" 0 latches"), "{stdout}");
-    // The G-code part on the Verilated path core: every axis's steps follow the rule.
-    assert!(
-        stdout.contains("path core in fabric:") && stdout.contains(": 0 differ;"),
-        "{stdout}"
-    );
-    for f in [
-        "seed001_table1.svg",
-        "seed001_table3_return.svg",
-        "seed000_all_limits.svg",
-        "demo_part_path_core.svg",
-    ] {
-        assert!(dir.join(f).exists(), "{f} not written");
-    }
-}
-
-#[test]
 fn cosim_bench_prints_medians_and_the_ratio() {
     let out = snapgen(&[
         "cosim",

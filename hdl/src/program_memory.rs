@@ -132,7 +132,11 @@ mod tests {
 
     #[test]
     fn program_memory_is_synthesizable() {
-        let stat = crate::synth_check::synth_block("program_memory", ProgramMemory::default());
+        let stat = crate::synth_check::synth_block_to(
+            "program_memory",
+            ProgramMemory::default(),
+            crate::synth_check::Depth::Xilinx,
+        );
         // Asynchronous read: distributed (LUT) RAM, no block RAM.
         assert!(stat.contains("RAM64M") && !stat.contains("RAMB"), "{stat}");
     }

@@ -60,7 +60,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let v = r.violations();
     if !v.is_empty() {
-        anyhow::bail!("over budget: {}", v.join("; "));
+        anyhow::bail!("synthesis check failed: {}", v.join("; "));
     }
     println!("motion core within budget");
     Ok(())
