@@ -659,18 +659,27 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
     let core_file = dir.join("snapgen_core.v");
     // Each design's files and top module, written first; then one Yosys per design, all at
     // once (each is one process on one core; they share nothing).
-    let write = |name: String, text: String| -> anyhow::Result<PathBuf> {
-        let file = dir.join(name);
-        std::fs::write(&file, text).with_context(|| format!("cannot write {}", file.display()))?;
-        Ok(file)
-    };
-    let sources = |prefix: &str, files: Vec<(String, String)>| -> anyhow::Result<Vec<PathBuf>> {
+    let write = |prefix: &str, files: Vec<(String, String)>| -> anyhow::Result<Vec<PathBuf>> {
         files
             .into_iter()
-            .map(|(name, text)| write(format!("{prefix}_{name}"), text))
+            .map(|(name, text)| {
+                let file = dir.join(format!("{prefix}{name}"));
+                std::fs::write(&file, text)
+                    .with_context(|| format!("cannot write {}", file.display()))?;
+                Ok(file)
+            })
             .collect()
     };
-    let jobs: Vec<(Vec<PathBuf>, String)> = vec![
+    // A design of one file, named after its top module.
+    let single = |top: &str, text: String| -> anyhow::Result<(Vec<PathBuf>, String)> {
+        Ok((
+            write("", vec![(format!("{top}.v"), text)])?,
+            top.to_string(),
+        ))
+    };
+    use snapgen_hdl::{interpolator as ip, path_core as pc, path_sequencer as ps};
+    use snapgen_hdl::{path_steppers as st, step_dir as sd};
+    let jobs: [(Vec<PathBuf>, String); 7] = [
         (
             vec![
                 core_file.clone(),
@@ -683,63 +692,42 @@ pub fn synth(b: &Board, timing: &Timing, design: &Design) -> anyhow::Result<Boar
             vec![core_file],
             snapgen_hdl::verilog::CORE_PREFIX.to_string(),
         ),
+        single(
+            ip::INTERPOLATOR_PREFIX,
+            ip::interpolator_verilog(INTERPOLATOR_AXES),
+        )?,
+        single(
+            ps::PATH_SEQUENCER_PREFIX,
+            ps::path_sequencer_verilog(INTERPOLATOR_AXES),
+        )?,
         (
-            vec![write(
-                format!("{}.v", snapgen_hdl::interpolator::INTERPOLATOR_PREFIX),
-                snapgen_hdl::interpolator::interpolator_verilog(INTERPOLATOR_AXES),
-            )?],
-            snapgen_hdl::interpolator::INTERPOLATOR_PREFIX.to_string(),
-        ),
-        (
-            vec![write(
-                format!("{}.v", snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX),
-                snapgen_hdl::path_sequencer::path_sequencer_verilog(INTERPOLATOR_AXES),
-            )?],
-            snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX.to_string(),
-        ),
-        (
-            sources(
-                "steppers",
-                snapgen_hdl::path_steppers::path_steppers_sources(INTERPOLATOR_AXES).to_vec(),
+            write(
+                "steppers_",
+                st::path_steppers_sources(INTERPOLATOR_AXES).to_vec(),
             )?,
-            snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX.to_string(),
+            st::PATH_STEPPERS_PREFIX.to_string(),
         ),
         (
-            sources(
-                "path_core",
-                snapgen_hdl::path_core::path_core_sources(INTERPOLATOR_AXES),
-            )?,
-            snapgen_hdl::path_core::PATH_CORE_PREFIX.to_string(),
+            write("path_core_", pc::path_core_sources(INTERPOLATOR_AXES))?,
+            pc::PATH_CORE_PREFIX.to_string(),
         ),
-        (
-            vec![write(
-                format!("{}.v", snapgen_hdl::step_dir::STEP_DIR_PREFIX),
-                snapgen_hdl::step_dir::step_dir_verilog(),
-            )?],
-            snapgen_hdl::step_dir::STEP_DIR_PREFIX.to_string(),
-        ),
+        single(sd::STEP_DIR_PREFIX, sd::step_dir_verilog())?,
     ];
     let family = &b.family;
-    let reports: Vec<anyhow::Result<crate::yosys::SynthReport>> = std::thread::scope(|s| {
-        let running: Vec<_> = jobs
-            .iter()
-            .map(|(files, top)| s.spawn(move || crate::yosys::synth(files, top, family)))
-            .collect();
-        running
-            .into_iter()
-            .map(|h| h.join().expect("a Yosys run's thread panicked"))
-            .collect()
-    });
-    let mut reports = reports.into_iter();
-    let mut next = || reports.next().expect("one report per design");
+    let [full, core, interpolator, path_sequencer, path_steppers, path_core, step_dir] =
+        std::thread::scope(|s| {
+            jobs.each_ref()
+                .map(|(files, top)| s.spawn(move || crate::yosys::synth(files, top, family)))
+                .map(|h| h.join().expect("a Yosys run's thread panicked"))
+        });
     let (full, core, interpolator, path_sequencer, path_steppers, path_core, step_dir) = (
-        next()?,
-        next()?,
-        next()?,
-        next()?,
-        next()?,
-        next()?,
-        next()?,
+        full?,
+        core?,
+        interpolator?,
+        path_sequencer?,
+        path_steppers?,
+        path_core?,
+        step_dir?,
     );
     let _ = std::fs::remove_dir_all(&dir);
     Ok(BoardSynth {
