@@ -4,7 +4,8 @@
 //! verilator --cc --exe --build -O3 -Wall --x-assign fast --x-initial fast --noassert
 //!           --top-module top top.v harness.cpp
 //!           -CFLAGS "-fPIC -march=native -fno-semantic-interposition -DSNAPGEN_TRACE=0|1"
-//!           -MAKEFLAGS "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3"
+//!           -MAKEFLAGS "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3"   (Opt::Speed; -O0 for
+//!                                                                 Opt::BuildTime)
 //!           -LDFLAGS "-shared -Wl,-Bsymbolic" -o libsnapgen_core.so
 //! ```
 //!
@@ -37,6 +38,29 @@ pub const HARNESS_CPP: &str = include_str!("../harness/harness.cpp");
 const CFLAGS: &str = "-fPIC -march=native -fno-semantic-interposition";
 /// Verilator makefile variables: the optimisation levels it would otherwise set to `-Os`.
 const MAKEFLAGS: &str = "OPT_FAST=-O3 OPT_SLOW=-O1 OPT_GLOBAL=-O3";
+/// The same for a library built to be run briefly (an altered design, run until the
+/// co-simulation finds the alteration): no C++ optimisation, which halves the build time
+/// (measured: 7.8 s against 3.8 s for the interpolator, 12.7 s against 6.9 s for the path core).
+const MAKEFLAGS_QUICK: &str = "OPT_FAST=-O0 OPT_SLOW=-O0 OPT_GLOBAL=-O0";
+
+/// What a build is optimised for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Opt {
+    /// The simulation's speed (`-O3`): every library that runs long streams.
+    Speed,
+    /// The build's time (`-O0`): a library that runs a short stream once, such as a
+    /// deliberately altered design in a test that the co-simulation must find.
+    BuildTime,
+}
+
+impl Opt {
+    fn makeflags(self) -> &'static str {
+        match self {
+            Opt::Speed => MAKEFLAGS,
+            Opt::BuildTime => MAKEFLAGS_QUICK,
+        }
+    }
+}
 /// Link flags: a shared library whose internal calls bind locally.
 const LDFLAGS: &str = "-shared -Wl,-Bsymbolic";
 
@@ -128,7 +152,15 @@ pub struct Built {
 pub fn build(core_verilog: &str, trace: bool) -> Result<Built, SimError> {
     let verilog = crate::wrapper::cosim_top(core_verilog);
     let layout = crate::fabric::core_layout_header();
-    build_with("core", "top", &verilog, HARNESS_CPP, &layout, trace)
+    build_with(
+        "core",
+        "top",
+        &verilog,
+        HARNESS_CPP,
+        &layout,
+        trace,
+        Opt::Speed,
+    )
 }
 
 /// Builds (or finds in the cache) the library of the I/O top `io_verilog` (the virtual board
@@ -141,6 +173,7 @@ pub fn build_io(io_verilog: &str, trace: bool) -> Result<Built, SimError> {
         HARNESS_CPP,
         &crate::io::io_layout_header(),
         trace,
+        Opt::Speed,
     )
 }
 
@@ -155,6 +188,7 @@ pub fn build_axi(verilog: &str, trace: bool) -> Result<Built, SimError> {
         HARNESS_CPP,
         &crate::axi::axi_layout_header(),
         trace,
+        Opt::Speed,
     )
 }
 
@@ -164,12 +198,14 @@ pub fn build_interpolator(axes: u8, trace: bool) -> Result<Built, SimError> {
     build_interpolator_from(
         &snapgen_hdl::interpolator::interpolator_verilog(axes),
         trace,
+        Opt::Speed,
     )
 }
 
 /// Builds the interpolator's library from the Verilog `verilog` (the generator's, or a
-/// deliberately altered copy: the tests show that the co-simulation finds an altered line).
-pub fn build_interpolator_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+/// deliberately altered copy: the tests show that the co-simulation finds an altered line),
+/// optimised for `opt`.
+pub fn build_interpolator_from(verilog: &str, trace: bool, opt: Opt) -> Result<Built, SimError> {
     build_with(
         "interp",
         snapgen_hdl::interpolator::INTERPOLATOR_PREFIX,
@@ -177,6 +213,7 @@ pub fn build_interpolator_from(verilog: &str, trace: bool) -> Result<Built, SimE
         HARNESS_CPP,
         &crate::interp::interp_layout_header(),
         trace,
+        opt,
     )
 }
 
@@ -186,12 +223,13 @@ pub fn build_path_sequencer(axes: u8, trace: bool) -> Result<Built, SimError> {
     build_path_sequencer_from(
         &snapgen_hdl::path_sequencer::path_sequencer_verilog(axes),
         trace,
+        Opt::Speed,
     )
 }
 
 /// Builds the path sequencer's library from the Verilog `verilog` (the generator's, or a
-/// deliberately altered copy).
-pub fn build_path_sequencer_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+/// deliberately altered copy), optimised for `opt`.
+pub fn build_path_sequencer_from(verilog: &str, trace: bool, opt: Opt) -> Result<Built, SimError> {
     build_with(
         "path-seq",
         snapgen_hdl::path_sequencer::PATH_SEQUENCER_PREFIX,
@@ -199,6 +237,7 @@ pub fn build_path_sequencer_from(verilog: &str, trace: bool) -> Result<Built, Si
         HARNESS_CPP,
         &crate::path_seq::path_seq_layout_header(),
         trace,
+        opt,
     )
 }
 
@@ -208,12 +247,13 @@ pub fn build_path_steppers(axes: u8, trace: bool) -> Result<Built, SimError> {
     build_path_steppers_from(
         &snapgen_hdl::path_steppers::path_steppers_sources_text(axes),
         trace,
+        Opt::Speed,
     )
 }
 
 /// Builds the path steppers' library from the Verilog `verilog` (every source of the stage:
-/// the generator's, or a deliberately altered copy).
-pub fn build_path_steppers_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+/// the generator's, or a deliberately altered copy), optimised for `opt`.
+pub fn build_path_steppers_from(verilog: &str, trace: bool, opt: Opt) -> Result<Built, SimError> {
     build_with(
         "path-steppers",
         snapgen_hdl::path_steppers::PATH_STEPPERS_PREFIX,
@@ -221,18 +261,23 @@ pub fn build_path_steppers_from(verilog: &str, trace: bool) -> Result<Built, Sim
         HARNESS_CPP,
         &crate::path_steppers::path_steppers_layout_header(),
         trace,
+        opt,
     )
 }
 
 /// Builds (or finds in the cache) the library of the path core for `axes` axes
 /// ([`crate::path_core`]: its file, the motion core's and the path steppers' four).
 pub fn build_path_core(axes: u8, trace: bool) -> Result<Built, SimError> {
-    build_path_core_from(&snapgen_hdl::path_core::path_core_sources_text(axes), trace)
+    build_path_core_from(
+        &snapgen_hdl::path_core::path_core_sources_text(axes),
+        trace,
+        Opt::Speed,
+    )
 }
 
 /// Builds the path core's library from the Verilog `verilog` (every source of it: the
-/// generator's, or a deliberately altered copy).
-pub fn build_path_core_from(verilog: &str, trace: bool) -> Result<Built, SimError> {
+/// generator's, or a deliberately altered copy), optimised for `opt`.
+pub fn build_path_core_from(verilog: &str, trace: bool, opt: Opt) -> Result<Built, SimError> {
     build_with(
         "path-core",
         snapgen_hdl::path_core::PATH_CORE_PREFIX,
@@ -240,6 +285,7 @@ pub fn build_path_core_from(verilog: &str, trace: bool) -> Result<Built, SimErro
         HARNESS_CPP,
         &crate::path_core::path_core_layout_header(),
         trace,
+        opt,
     )
 }
 
@@ -253,6 +299,7 @@ pub fn build_step_dir(trace: bool) -> Result<Built, SimError> {
         HARNESS_CPP,
         &crate::step_dir::step_dir_layout_header(),
         trace,
+        Opt::Speed,
     )
 }
 
@@ -266,6 +313,7 @@ fn build_with(
     harness: &str,
     layout: &str,
     trace: bool,
+    opt: Opt,
 ) -> Result<Built, SimError> {
     let version = verilator_version()?;
     let key = fnv1a(&[
@@ -276,7 +324,7 @@ fn build_with(
         version.as_bytes(),
         CFLAGS.as_bytes(),
         host_cpu().as_bytes(),
-        MAKEFLAGS.as_bytes(),
+        opt.makeflags().as_bytes(),
         LDFLAGS.as_bytes(),
         &[u8::from(trace)],
     ]);
@@ -327,7 +375,7 @@ fn build_with(
             "-CFLAGS",
             &format!("{CFLAGS} -DSNAPGEN_TRACE={}", u8::from(trace)),
         ])
-        .args(["-MAKEFLAGS", MAKEFLAGS])
+        .args(["-MAKEFLAGS", opt.makeflags()])
         .args(["-LDFLAGS", LDFLAGS, "-o", "libsnapgen_core.so"]);
     if trace {
         cmd.arg("--trace");

@@ -5,7 +5,7 @@
 //! clock (that shows the comparison and its report work; that the stream reaches the logic is
 //! shown by the disturbance counts and by the rule checks).
 
-use snapgen_sim::build::{build_interpolator, build_interpolator_from};
+use snapgen_sim::build::{build_interpolator, build_interpolator_from, Opt};
 use snapgen_sim::interp::{run, InterpConfig, PortFault, INTERP_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> InterpConfig {
@@ -92,7 +92,8 @@ fn an_altered_line_of_the_verilog_is_found() {
             if from.starts_with("next") { 2 } else { 1 }
         );
         let bad = good.replace(from, to);
-        let lib = build_interpolator_from(&bad, false).expect("the altered design builds");
+        let lib = build_interpolator_from(&bad, false, Opt::BuildTime)
+            .expect("the altered design builds");
         let r = run(&lib.library, &config(3, 2_000_000, 3)).expect("runs");
         assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }

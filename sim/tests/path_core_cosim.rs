@@ -2,7 +2,7 @@
 //! against its model, every output on every clock, and each axis's lines counted as its drive
 //! counts them (needs Verilator; the README's test command installs it).
 
-use snapgen_sim::build::{build_path_core, build_path_core_from};
+use snapgen_sim::build::{build_path_core, build_path_core_from, Opt};
 use snapgen_sim::path_core::{run, PathCoreConfig, PortFault, PATH_CORE_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> PathCoreConfig {
@@ -66,7 +66,8 @@ fn an_altered_line_of_the_verilog_is_found() {
     ] {
         assert_eq!(good.matches(from).count(), 1, "{from}");
         let bad = good.replace(from, to);
-        let lib = build_path_core_from(&bad, false).expect("the altered design builds");
+        let lib =
+            build_path_core_from(&bad, false, Opt::BuildTime).expect("the altered design builds");
         let r = run(&lib.library, &config(2, 1_000_000, 6)).expect("runs");
         assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }

@@ -2,7 +2,7 @@
 //! positions it commits against the rule (needs Verilator; the README's test command installs
 //! it).
 
-use snapgen_sim::build::{build_path_sequencer, build_path_sequencer_from};
+use snapgen_sim::build::{build_path_sequencer, build_path_sequencer_from, Opt};
 use snapgen_sim::path_seq::{run, PathSeqConfig, PortFault, PATH_SEQ_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> PathSeqConfig {
@@ -80,7 +80,8 @@ fn an_altered_line_of_the_verilog_is_found() {
     ] {
         assert_eq!(good.matches(from).count(), 1, "{from}");
         let bad = good.replace(from, to);
-        let lib = build_path_sequencer_from(&bad, false).expect("the altered design builds");
+        let lib = build_path_sequencer_from(&bad, false, Opt::BuildTime)
+            .expect("the altered design builds");
         let r = run(&lib.library, &config(3, 2_000_000, 5)).expect("runs");
         assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }

@@ -2,7 +2,7 @@
 //! axis) against their model, every output on every clock, and each axis's lines counted as
 //! its drive counts them (needs Verilator; the README's test command installs it).
 
-use snapgen_sim::build::{build_path_steppers, build_path_steppers_from};
+use snapgen_sim::build::{build_path_steppers, build_path_steppers_from, Opt};
 use snapgen_sim::path_steppers::{run, PathSteppersConfig, PortFault, PATH_STEPPERS_OUTPUTS};
 
 fn config(axes: u8, clocks: u64, seed: u64) -> PathSteppersConfig {
@@ -70,7 +70,8 @@ fn an_altered_line_of_the_verilog_is_found() {
     ] {
         assert_eq!(good.matches(from).count(), 1, "{from}");
         let bad = good.replace(from, to);
-        let lib = build_path_steppers_from(&bad, false).expect("the altered design builds");
+        let lib = build_path_steppers_from(&bad, false, Opt::BuildTime)
+            .expect("the altered design builds");
         let r = run(&lib.library, &config(3, 2_000_000, 6)).expect("runs");
         assert!(r.mismatch.is_some(), "{to:?} was not found: {r:?}");
     }
