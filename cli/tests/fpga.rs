@@ -195,8 +195,9 @@ fn every_generated_file_reads_together() {
     modules.dedup();
     assert_eq!(modules.len(), n, "a module name is defined twice");
     // The board top makes the 100 MHz from the Zybo's 125 MHz with an MMCM: Verilator reads
-    // stand-ins for the primitives (Yosys knows them). Each top lints clean on its own; all
-    // three are synthesised, and checked for latches, by `snapgen synth` (its test below).
+    // stand-ins for the primitives (Yosys knows them). Each top lints clean on its own; the
+    // board top, which holds the other two, and the motion core alone are synthesised and
+    // checked for latches by `snapgen synth` (its test below).
     let stand_ins = write_xc7_stand_ins(&dir);
     for top in ["snapgen_zybo_z7_10", "snapgen_io", "snapgen_core"] {
         let mut lint_files = files.clone();
